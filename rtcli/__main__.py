@@ -1,0 +1,3 @@
+from rtcli.cli import main
+
+main()

@@ -1,0 +1,163 @@
+"""Scene file -> Scene: the top level, the camera, lights and settings (SCENE_FORMAT.md).
+
+Only this module, build_objects.py, params.py and yamlfile.py know YAML keys.
+Every key is read through Params, so unknown keys are reported with file:line:col.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from rtcli import camera as cameras
+from rtcli import yamlfile
+from rtcli.build_objects import ObjectBuilder, material_from
+from rtcli.errors import SceneError
+from rtcli.lights import PointLight
+from rtcli.materials import Material, MaterialTable
+from rtcli.params import Params, as_params
+from rtcli.scene import Scene, Settings
+
+MAX_SIZE = 32768
+
+
+def load_scene(path: str) -> Scene:
+    """Read, check and build the scene at `path` (with its includes)."""
+    return scene_from_docs(yamlfile.load(path))
+
+
+def scene_from_docs(docs: list) -> Scene:
+    """Included documents first, the main file last; only the main file sets camera and image."""
+    main = Params(docs[-1], "")
+    for doc in docs:
+        p = main if doc is docs[-1] else Params(doc, "")
+        if p.has("version") and p.raw("version") != 1:
+            raise p.error("version", f"unsupported version {p.raw('version')!r} (this is version 1)")
+        p.read.update(("version", "include"))
+    named, table = {}, [Material()]
+    for doc in docs:
+        p = main if doc is docs[-1] else Params(doc, "")
+        for name, mp in _materials(p):
+            named[name] = len(table)
+            table.append(material_from(mp))
+    builder = ObjectBuilder(named, table, 0)
+    lights = []
+    for doc in docs:
+        p = main if doc is docs[-1] else Params(doc, "")
+        lights += [light_from(as_params(item, where, path, "a light mapping"))
+                   for item, where, path in p.items("lights", [])]
+        builder.add_all(p.items("objects", []))
+        if doc is not docs[-1]:
+            p.check_unused()
+    scene = _top_level(main, builder, lights, table)
+    main.check_unused()
+    return scene
+
+
+def _materials(p: Params):
+    if not p.has("materials"):
+        p.read.add("materials")
+        return []
+    m = p.sub("materials")
+    out = [(name, m.sub(name)) for name in m.node]
+    m.read.update(m.node)
+    return out
+
+
+def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
+    settings = Settings()
+    if p.has("image"):
+        img = p.sub("image")
+        settings.width = img.integer("width", 640, 1, MAX_SIZE)
+        settings.height = img.integer("height", 480, 1, MAX_SIZE)
+        img.check_unused()
+    else:
+        p.read.add("image")
+    if p.has("render"):
+        r = p.sub("render")
+        settings.max_depth = r.integer("max_depth", 5, 1, 64)
+        settings.specular = r.choice("specular", ("phong", "blinn"), "phong")
+        settings.samples = r.integer("samples", 1, 1, 16)
+        settings.epsilon = r.number("epsilon", 1e-6, positive=True)
+        r.check_unused()
+    else:
+        p.read.add("render")
+    camera, eye = camera_from(p.sub("camera"))
+    return Scene(camera=camera, objects=builder.objects, materials=MaterialTable(table),
+                 lights=lights, background=p.color("background", (0.0, 0.0, 0.0)),
+                 ambient=p.color("ambient", (0.1, 0.1, 0.1)), settings=settings, eye=eye)
+
+
+def camera_from(c: Params):
+    """One of the three camera forms; returns (callable (nc, nr) -> Camera, eye)."""
+    eye = c.vector("eye")
+    if c.has("screen"):
+        s = c.sub("screen")
+        ll, h, v = s.vector("lower_left"), s.vector("horizontal"), s.vector("vertical")
+        s.check_unused()
+        if np.linalg.norm(np.cross(h, v)) == 0:
+            raise s.error(None, "horizontal and vertical must span a rectangle (not zero or parallel)")
+        c.check_unused()
+        return functools.partial(cameras.from_screen, eye, ll, h, v), eye
+    look_at, up = c.vector("look_at"), c.vector("up", (0.0, 1.0, 0.0))
+    try:
+        cameras.eye_basis(eye, look_at, up)
+    except ValueError as e:
+        raise c.error("up" if "up" in str(e) else "look_at", str(e)) from None
+    if c.has("window"):
+        focal = c.number("focal", 1.0, positive=True)
+        w = c.sub("window")
+        wl, wr, wt, wb = (w.number(k) for k in ("left", "right", "top", "bottom"))
+        w.check_unused()
+        if wl == wr or wt == wb:
+            raise w.error(None, "the window must have left != right and top != bottom")
+        c.check_unused()
+        return functools.partial(cameras.from_window, eye, look_at, up, focal, wl, wr, wt, wb), eye
+    fov = c.number("fov", 45.0)
+    if not 0 < fov < 180:
+        raise c.error("fov", f"must be between 0 and 180 degrees, got {fov:g}")
+    c.check_unused()
+    return functools.partial(cameras.from_fov, eye, look_at, up, fov), eye
+
+
+def light_from(p: Params) -> PointLight:
+    position, color = p.vector("position"), p.color("color", (1.0, 1.0, 1.0))
+    att = p.numbers("attenuation", 3, (1.0, 0.0, 0.0), "[c0, c1, c2]")
+    if np.any(att < 0) or not np.any(att):
+        raise p.error("attenuation", "c0, c1, c2 must be >= 0 and not all 0")
+    extra = {}
+    if p.has("spot"):
+        s = p.sub("spot")
+        direction = s.vector("direction")
+        if not np.any(direction):
+            raise s.error("direction", "must not be the zero vector")
+        angle = s.number("angle", 30.0)
+        if not 0 < angle <= 180:
+            raise s.error("angle", f"must be in (0, 180] degrees, got {angle:g}")
+        extra.update(spot_direction=direction / np.linalg.norm(direction),
+                     spot_cos=float(np.cos(np.radians(angle))),
+                     spot_falloff=s.number("falloff", 0.0, non_negative=True))
+        s.check_unused()
+    else:
+        p.read.add("spot")
+    if p.has("area"):
+        a = p.sub("area")
+        extra.update(area_u=a.vector("u"), area_v=a.vector("v"), area_samples=a.integer("samples", 3, 1, 16))
+        a.check_unused()
+    else:
+        p.read.add("area")
+    p.check_unused()
+    return PointLight(position, color, att, **extra)
+
+
+def summary(scene: Scene) -> str:
+    """One line for `rtcli validate`."""
+    s = scene.settings
+    kinds = {}
+    for o in scene.objects:
+        kinds[o.kind] = kinds.get(o.kind, 0) + 1
+    shapes = ", ".join(f"{n} {k}" for k, n in kinds.items())
+    return (f"{len(scene.objects)} objects ({shapes or 'none'}), {len(scene.lights)} lights, "
+            f"{len(scene.materials) - 1} materials; {s.width}x{s.height}, max_depth {s.max_depth}, "
+            f"{s.specular}, samples {s.samples}")

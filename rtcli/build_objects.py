@@ -1,0 +1,229 @@
+"""Scene tree -> materials, textures, transforms and objects (the YAML side of them).
+
+Object ids are 1, 2, 3 ... in file order, depth first through groups; a csg or a
+mesh is one object. Groups are flattened: each child gets the group's transform
+after its own, and the group's material when it names none.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from PIL import Image, UnidentifiedImageError
+
+from rtcli import transform as tf
+from rtcli.errors import SceneError
+from rtcli.materials import Material
+from rtcli.params import Params, as_params, describe
+from rtcli.presets import PRESETS
+from rtcli.scene import SceneObject
+from rtcli.shapes import SHAPES
+from rtcli.textures import Checker, ImageTexture
+
+OBJECT_KINDS = tuple(SHAPES) + ("csg", "group")
+
+
+# --- materials ---
+def material_from(p: Params) -> Material:
+    """A material mapping: optional `preset:` first, then each key overrides."""
+    base = {}
+    if p.has("preset"):
+        name = p.string("preset")
+        if name not in PRESETS:
+            raise p.error("preset", f"unknown preset '{name}' (see `rtcli presets`)")
+        pre = PRESETS[name]
+        base = dict(ambient=pre.ambient, diffuse=pre.diffuse, specular=pre.specular, shininess=pre.shininess)
+    else:
+        p.read.add("preset")
+    diffuse = p.coefficient("diffuse", base.get("diffuse", 0.8))
+    m = Material(
+        ambient=p.coefficient("ambient", base.get("ambient", diffuse)),
+        diffuse=diffuse,
+        specular=p.coefficient("specular", base.get("specular", 0.0)),
+        shininess=p.number("shininess", base.get("shininess", 32.0), non_negative=True),
+        emission=p.color("emission", (0.0, 0.0, 0.0)),
+        reflection=p.coefficient("reflection", 0.0),
+        transmission=p.coefficient("transmission", 0.0),
+        ior=p.number("ior", 1.0, positive=True),
+        shadow=p.boolean("shadow", True),
+        texture=texture_from(p.sub("texture", None)) if p.has("texture") else _unread(p, "texture"),
+    )
+    p.check_unused()
+    return m
+
+
+def _unread(p: Params, key: str):
+    p.read.add(key)
+    return None
+
+
+def texture_from(p: Params):
+    kinds = [k for k in ("checker", "image") if p.has(k)]
+    if len(kinds) != 1:
+        raise p.error(None, "a texture needs exactly one of: checker, image")
+    if kinds[0] == "checker":
+        c = p.sub("checker")
+        colors = c.items("colors")
+        if len(colors) != 2:
+            raise c.error("colors", f"must be a list of 2 colors, got {describe(c.node['colors'])}")
+        c1, c2 = (c.color_value("colors", v, path, where) for v, where, path in colors)
+        tex = Checker(c1, c2, c.number("size", 1.0, positive=True))
+        c.check_unused()
+    else:
+        tex = ImageTexture(load_texels(p, "image"), p.boolean("repeat", True))
+    p.check_unused()
+    return tex
+
+
+def load_texels(p: Params, key: str) -> np.ndarray:
+    path = os.path.join(p.folder, p.string(key))
+    try:
+        with Image.open(path) as img:
+            return np.asarray(img.convert("RGB"), dtype=float) / 255.0
+    except FileNotFoundError:
+        raise p.error(key, f"file not found: {path}") from None
+    except (UnidentifiedImageError, OSError) as e:
+        raise p.error(key, f"cannot read image {path}: {e}") from None
+
+
+def material_ref(p: Params, key: str, named: dict, table: list, default: int) -> int:
+    """The material row for `material:`: a name from `materials` or an inline mapping."""
+    if not p.has(key):
+        p.read.add(key)
+        return default
+    value = p.raw(key)
+    if isinstance(value, str):
+        if value not in named:
+            raise p.error(key, f"unknown material '{value}'")
+        return named[value]
+    table.append(material_from(p.sub(key)))
+    return len(table) - 1
+
+
+# --- transforms ---
+def transform_from(p: Params) -> tf.Transform | None:
+    """The `transform:` list, composed in the order written (first listed applies first)."""
+    if not p.has("transform"):
+        p.read.add("transform")
+        return None
+    total = tf.Transform.identity()
+    for item, where, path in p.items("transform"):
+        step = as_params(item, where, path, "a mapping with one of: scale, rotate, translate, matrix")
+        total = total.then(_one_transform(step))
+    return total
+
+
+def _one_transform(p: Params) -> tf.Transform:
+    keys = list(p.node)
+    if len(keys) != 1 or keys[0] not in ("scale", "rotate", "translate", "matrix"):
+        raise p.error(None, "each transform step is one of: scale, rotate, translate, matrix")
+    kind = keys[0]
+    try:
+        if kind == "translate":
+            return tf.translate(p.vector("translate"))
+        if kind == "scale":
+            value = p.raw("scale")
+            s = p.number("scale") if not isinstance(value, list) else p.vector("scale")
+            return tf.scale(s)
+        if kind == "rotate":
+            r = p.sub("rotate")
+            axis, degrees = r.vector("axis"), r.number("degrees")
+            r.check_unused()
+            if not np.any(axis):
+                raise r.error("axis", "must not be the zero vector")
+            return tf.rotate(axis, degrees)
+        return tf.Transform.from_matrix(_matrix(p))
+    except ValueError as e:
+        raise p.error(kind, str(e)) from None
+
+
+def _matrix(p: Params) -> np.ndarray:
+    rows = p.items("matrix")
+    if len(rows) not in (3, 4):
+        raise p.error("matrix", f"must be 3 or 4 rows of 4 numbers, got {describe(p.node['matrix'])}")
+    m = np.eye(4)
+    for k, (row, where, path) in enumerate(rows):
+        m[k] = p._item_numbers(p.node["matrix"], k, row, 4, "a row of 4 numbers", path)
+    if not np.array_equal(m[3], [0, 0, 0, 1]):
+        raise p.error("matrix", "the 4th row must be [0, 0, 0, 1] (affine transforms only)")
+    return m
+
+
+# --- objects ---
+class ObjectBuilder:
+    """Builds SceneObjects from `objects:` lists, numbering them 1, 2, 3 ..."""
+
+    def __init__(self, named: dict, table: list, default_material: int):
+        self.named, self.table, self.default = named, table, default_material
+        self.objects: list[SceneObject] = []
+
+    def add_all(self, items, parent: tf.Transform | None = None, material: int | None = None):
+        for item, where, path in items:
+            self.add(as_params(item, where, path, "an object (a mapping with a shape key)"), parent,
+                     self.default if material is None else material)
+
+    def add(self, p: Params, parent, inherited: int) -> None:
+        kind = self._kind(p)
+        p.string("name", "")
+        world = _compose(transform_from(p), parent)
+        material = material_ref(p, "material", self.named, self.table, inherited)
+        if kind == "group":
+            g = self._shape_params(p, kind)
+            self.add_all(g.items("objects"), world, material)
+            g.check_unused()
+        else:
+            shape = self.shape(p, kind)
+            self.objects.append(SceneObject(len(self.objects) + 1, p.node.get("name", ""), shape,
+                                            material, world, kind))
+        p.check_unused()
+
+    def shape(self, p: Params, kind: str):
+        sp = self._shape_params(p, kind)
+        if kind == "csg":
+            from rtcli.shapes.csg import csg_from
+            shape = csg_from(sp, self)
+        else:
+            shape = SHAPES[kind].from_params(sp)
+        sp.check_unused()
+        return shape
+
+    def child(self, p: Params, inherited: int):
+        """(shape, world_from_object, material) of a csg child, which gets no id of its own."""
+        kind = self._kind(p)
+        if kind == "group":
+            raise p.error("group", "a csg child must be a shape or a csg, not a group")
+        p.string("name", "")
+        t = transform_from(p)
+        material = material_ref(p, "material", self.named, self.table, inherited)
+        shape = self.shape(p, kind)
+        p.check_unused()
+        return shape, t, material
+
+    @staticmethod
+    def _kind(p: Params) -> str:
+        kinds = [k for k in p.node if k in OBJECT_KINDS]
+        if len(kinds) > 1:
+            raise SceneError(p.node.key_where[kinds[1]], p.key_path(kinds[1]),
+                             f"an object has one shape, but '{kinds[0]}' is already given")
+        if not kinds:
+            p.read.update(("name", "material", "transform") + OBJECT_KINDS)
+            p.check_unused()
+            raise p.error(None, f"missing shape: one of {', '.join(OBJECT_KINDS)}")
+        return kinds[0]
+
+    @staticmethod
+    def _shape_params(p: Params, kind: str) -> Params:
+        if p.node[kind] is None:
+            p.read.add(kind)
+            empty = type(p.node)()
+            empty.where, empty.key_where, empty.value_where = p.node.value_where[kind], {}, {}
+            empty.folder = p.folder
+            return Params(empty, p.key_path(kind))
+        return p.sub(kind)
+
+
+def _compose(own: tf.Transform | None, parent: tf.Transform | None) -> tf.Transform | None:
+    if own is None:
+        return parent
+    return own if parent is None else own.then(parent)

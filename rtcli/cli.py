@@ -1,0 +1,200 @@
+"""The rtcli command line (CLI.md): render, signature, compare, validate, presets.
+
+Argument handling only. Errors from the library (RtcliError) and usage errors
+become one `error: ...` line on stderr with exit code 2; `--debug` shows the
+traceback instead.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+import click
+
+from rtcli import __version__
+from rtcli.errors import RtcliError
+
+SIZE = click.IntRange(1, 32768)
+
+
+class RtcliGroup(click.Group):
+    """A click group whose errors are one line: 'error: ...', exit 2."""
+
+    def main(self, args=None, prog_name=None, **extra):
+        args = list(sys.argv[1:] if args is None else args)
+        extra.pop("standalone_mode", None)
+        try:
+            code = super().main(args, prog_name or "rtcli", standalone_mode=False, **extra)
+        except click.exceptions.Exit as e:
+            sys.exit(e.exit_code)
+        except click.exceptions.Abort:
+            click.echo("error: interrupted", err=True)
+            sys.exit(130)
+        except click.ClickException as e:
+            click.echo(f"error: {e.format_message()}", err=True)
+            sys.exit(2)
+        except RtcliError as e:
+            if "--debug" in args:
+                raise
+            click.echo(f"error: {e}", err=True)
+            sys.exit(2)
+        sys.exit(code if isinstance(code, int) else 0)
+
+
+@click.group(cls=RtcliGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="rtcli")
+@click.option("--debug", is_flag=True, help="Show a traceback on errors.")
+def main(debug):
+    """rtcli: a Whitted ray tracer for YAML scene files."""
+
+
+def _load(path):
+    from rtcli.build import load_scene
+    return load_scene(path)
+
+
+def _output(scene_path: str, out: str | None, suffix: str = ".png") -> str:
+    out = out or os.path.splitext(os.path.basename(scene_path))[0] + suffix
+    folder = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(folder):
+        raise RtcliError(f"{out}: output folder does not exist")
+    return out
+
+
+def _job(scene, width, height, block_size, **kw):
+    from rtcli.render import Job
+    width = width or scene.settings.width
+    height = height or scene.settings.height
+    return Job(width, height, block_size, **kw)
+
+
+def _progress(enabled: bool, label: str):
+    if not enabled:
+        return None
+
+    def show(done, total):
+        bar = "#" * (30 * done // total)
+        click.echo(f"\r{label} [{bar:<30}] {100 * done // total:3d}%", err=True, nl=done == total)
+    return show
+
+
+@main.command()
+@click.argument("scene_file", metavar="SCENE.yaml")
+@click.option("-o", "--output", metavar="OUT.png", help="Output PNG (default: the scene's name .png).")
+@click.option("--width", type=SIZE, help="Image width (the camera is kept).")
+@click.option("--height", type=SIZE, help="Image height (the camera is kept).")
+@click.option("--block-size", type=click.IntRange(1, 1024), default=1, show_default=True,
+              help="Preview: one ray per N x N block, through its top-left pixel.")
+@click.option("--samples", type=click.IntRange(1, 16), help="N x N samples per pixel.")
+@click.option("--max-depth", type=click.IntRange(1, 64), help="Rays per path, the primary included.")
+@click.option("--workers", type=click.IntRange(1, 256), help="Worker processes (default: all cores).")
+@click.option("--tile", type=click.IntRange(1, 4096), default=64, show_default=True,
+              help="Tile edge in pixels (memory per worker).")
+@click.option("--gamma", is_flag=True, help="sRGB-encode the output (default: linear).")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("--progress", is_flag=True, help="Show the progress bar even when stderr is not a terminal.")
+@click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")
+def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
+           gamma, quiet, progress, stats):
+    """Render SCENE.yaml to a PNG."""
+    from rtcli.render import render as render_image
+    from rtcli.writer import write_png
+    start = time.perf_counter()
+    scene = _load(scene_file)
+    out = _output(scene_file, output)
+    if samples:
+        scene.settings.samples = samples
+    if max_depth:
+        scene.settings.max_depth = max_depth
+    job = _job(scene, width, height, block_size, tile=tile, gamma=gamma)
+    show = _progress(not quiet and (progress or sys.stderr.isatty()), os.path.basename(scene_file))
+    image, counts = render_image(scene, job, workers or os.cpu_count() or 1, show)
+    write_png(out, image)
+    if stats:
+        seconds = time.perf_counter() - start
+        click.echo(f"rays: {counts.primary} primary, {counts.shadow} shadow, {counts.reflected} reflected, "
+                   f"{counts.refracted} refracted, {counts.total} total; {seconds:.2f} s; "
+                   f"{counts.total / max(seconds, 1e-9):,.0f} rays/s")
+
+
+@main.command()
+@click.argument("scene_file", metavar="SCENE.yaml")
+@click.option("-o", "--output", metavar="OUT.png", help="Color-coded signature (default: NAME.sig.png).")
+@click.option("--ids", "ids_out", metavar="IDS.png", help="Also write the raw ids as a 16-bit gray PNG.")
+@click.option("--legend", is_flag=True, help="Print id, name, shape and pixels covered.")
+@click.option("--width", type=SIZE, help="Image width (the camera is kept).")
+@click.option("--height", type=SIZE, help="Image height (the camera is kept).")
+@click.option("--block-size", type=click.IntRange(1, 1024), default=1, show_default=True,
+              help="One ray per N x N block, through its top-left pixel.")
+@click.option("--workers", type=click.IntRange(1, 256), help="Worker processes (default: all cores).")
+def signature(scene_file, output, ids_out, legend, width, height, block_size, workers):
+    """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
+    import numpy as np
+    from rtcli.render import render as render_image
+    from rtcli.writer import signature_colors, write_png
+    scene = _load(scene_file)
+    out = _output(scene_file, output, ".sig.png")
+    if ids_out:
+        _output(scene_file, ids_out)
+    job = _job(scene, width, height, block_size, signature=True)
+    ids, _ = render_image(scene, job, workers or os.cpu_count() or 1)
+    write_png(out, signature_colors(ids))
+    if ids_out:
+        write_png(ids_out, ids)
+    if legend:
+        counts = np.bincount(ids.ravel(), minlength=len(scene.objects) + 1)
+        click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
+        click.echo(f"{0:>5}  {'(background)':<24} {'-':<10} {counts[0]:>9}")
+        for o in scene.objects:
+            click.echo(f"{o.id:>5}  {o.name or '-':<24} {o.kind:<10} {counts[o.id]:>9}")
+
+
+@main.command()
+@click.argument("actual", metavar="ACTUAL.png")
+@click.argument("expected", metavar="EXPECTED.png")
+@click.option("--diff", metavar="DIFF.png", help="Write a heat map of the difference.")
+@click.option("--ids", "ids_mode", is_flag=True, help="Compare signature id maps (16-bit gray PNGs).")
+@click.option("--tolerance", type=click.IntRange(0, 255), default=2, show_default=True,
+              help="A pixel is bad when a channel differs by more than this (of 255).")
+@click.option("--max-bad-pixels", type=click.IntRange(0), default=16, show_default=True,
+              help="Bad pixels allowed: the larger of this and --max-bad-fraction of the image.")
+@click.option("--max-bad-fraction", type=click.FloatRange(0, 1), default=1e-4, show_default=True)
+@click.option("--max-cluster", type=click.IntRange(0), default=3, show_default=True,
+              help="Largest allowed 8-connected cluster of bad pixels.")
+@click.option("--max-boundary-mismatch", type=click.IntRange(0), default=8, show_default=True,
+              help="--ids: mismatches allowed on id boundaries (or the fraction below, if larger).")
+@click.option("--max-boundary-fraction", type=click.FloatRange(0, 1), default=0.01, show_default=True)
+def compare(actual, expected, diff, ids_mode, tolerance, max_bad_pixels, max_bad_fraction,
+            max_cluster, max_boundary_mismatch, max_boundary_fraction):
+    """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it."""
+    from rtcli import compare as cmp
+    from rtcli.writer import write_png
+    a, e = cmp.read_png(actual), cmp.read_png(expected)
+    if ids_mode:
+        result = cmp.compare_ids(a, e, max_boundary_mismatch, max_boundary_fraction)
+    else:
+        result = cmp.compare(a, e, tolerance=tolerance, max_bad_pixels=max_bad_pixels,
+                             max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
+    if diff and a.shape == e.shape and a.ndim == 3:
+        write_png(diff, cmp.heat_map(a, e, tolerance))
+    click.echo(result.summary)
+    if not result.ok:
+        raise click.exceptions.Exit(1)
+
+
+@main.command()
+@click.argument("scene_file", metavar="SCENE.yaml")
+def validate(scene_file):
+    """Parse and check a scene; print a summary. Renders nothing."""
+    from rtcli.build import summary
+    click.echo(f"{scene_file}: ok: {summary(_load(scene_file))}")
+
+
+@main.command()
+def presets():
+    """List the material presets (McReynolds and Blythe) with their coefficients."""
+    from rtcli.presets import table_rows
+    for row in table_rows():
+        click.echo(row)

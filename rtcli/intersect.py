@@ -1,0 +1,112 @@
+"""Ray-scene queries: the first hit (findFirstHit of notes 000 11.7), the surface at
+each hit, and shadow feelers.
+
+`t` first, surface second: `find_first_hit` keeps only the nearest t and which
+object and primitive gave it; `surface` then computes points, normals, (u, v)
+and texture colors for the rays that hit something.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from rtcli.rays import Rays
+from rtcli.scene import Scene
+from rtcli.vec import dot, normalize
+
+
+@dataclass(frozen=True)
+class Hits:
+    t: np.ndarray           # (n,) nearest t > t_min, inf on a miss
+    obj: np.ndarray         # (n,) index into scene.objects, -1 on a miss
+    prim: np.ndarray        # (n,) which surface/triangle of that object
+
+    def __getitem__(self, which) -> "Hits":
+        return Hits(self.t[which], self.obj[which], self.prim[which])
+
+
+@dataclass(frozen=True)
+class Surface:
+    p: np.ndarray           # (n, 3) hit points, world space
+    n: np.ndarray           # (n, 3) unit shading normal, turned to face the incoming ray
+    ng: np.ndarray          # (n, 3) unit geometric normal, same side as n (for offsets)
+    entering: np.ndarray    # (n,) the ray arrives on the outside (d . outward normal < 0)
+    material: np.ndarray    # (n,) row of the MaterialTable
+    texture: np.ndarray     # (n, 3) texture color T (1 without a texture)
+
+
+def object_hit(obj, o, d, t_min, t_max):
+    """(t, prim) of one scene object for rays o + t d in world space."""
+    o_obj, d_obj = obj.to_object(o, d)
+    t, prim = obj.shape.intersect(o_obj, d_obj, t_min, t_max)
+    return t, (np.zeros(len(o), dtype=np.int64) if prim is None else prim)
+
+
+def find_first_hit(scene: Scene, rays: Rays, t_min: float = 0.0) -> Hits:
+    """Nearest hit over all objects (an acceleration structure, when built, prunes them)."""
+    if scene.accel is not None:
+        return scene.accel.first_hit(scene, rays, t_min)
+    n = len(rays)
+    best = Hits(np.full(n, np.inf), np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=np.int64))
+    for k, obj in enumerate(scene.objects):
+        t, prim = object_hit(obj, rays.origin, rays.direction, t_min, best.t)
+        closer = t < best.t
+        best.t[closer], best.obj[closer], best.prim[closer] = t[closer], k, prim[closer]
+    return best
+
+
+def occluded(scene: Scene, points: np.ndarray, lights: np.ndarray) -> np.ndarray:
+    """Shadow feelers p + t (l - p): True where an object that casts shadows is hit for 0 < t < 1."""
+    if scene.accel is not None:
+        return scene.accel.occluded(scene, points, lights)
+    d = lights - points
+    blocked = np.zeros(len(points), dtype=bool)
+    for obj in scene.objects:
+        if not scene.materials.shadow[obj.material]:
+            continue
+        todo = np.flatnonzero(~blocked)
+        if len(todo) == 0:
+            break
+        t, _ = object_hit(obj, points[todo], d[todo], 0.0, 1.0)
+        blocked[todo] = np.isfinite(t)
+    return blocked
+
+
+def surface(scene: Scene, rays: Rays, hits: Hits) -> Surface:
+    """The surface record of rays that hit (notes 000 11.6): normals by A^-T n, (u, v), T."""
+    n = len(rays)
+    p = rays.at(hits.t)
+    normal, geometric = np.empty((n, 3)), np.empty((n, 3))
+    material, texture = np.empty(n, dtype=np.int64), np.ones((n, 3))
+    for k in np.unique(hits.obj):
+        rows = np.flatnonzero(hits.obj == k)
+        obj = scene.objects[k]
+        o_obj, d_obj = obj.to_object(rays.origin[rows], rays.direction[rows])
+        p_obj = o_obj + hits.t[rows, None] * d_obj
+        prim = hits.prim[rows]
+        ns = obj.shape.normal(p_obj, prim)
+        ng = obj.shape.geometric_normal(p_obj, prim) if hasattr(obj.shape, "geometric_normal") else ns
+        mat = obj.shape.material_of(prim, obj.material) if hasattr(obj.shape, "material_of") \
+            else np.full(len(rows), obj.material)
+        if obj.world_from_object is not None:
+            ns, ng = obj.world_from_object.normal(ns), obj.world_from_object.normal(ng)
+        normal[rows], geometric[rows], material[rows] = normalize(ns), normalize(ng), mat
+        _texture(scene, obj, p_obj, prim, mat, texture, rows)
+    entering = dot(rays.direction, geometric) < 0
+    facing = np.where(entering, 1.0, -1.0)[:, None]
+    n_face = normal * facing
+    n_face = np.where((dot(n_face, rays.direction) > 0)[:, None], geometric * facing, n_face)
+    return Surface(p, n_face, geometric * facing, entering, material, texture)
+
+
+def _texture(scene, obj, p_obj, prim, mat, texture, rows) -> None:
+    """Fill texture[rows] for the textured materials among `mat`."""
+    table = scene.materials
+    for m in table.textured:
+        sel = mat == m
+        if sel.any():
+            p_sel = p_obj[sel]
+            uv = obj.shape.uv(p_sel, prim[sel])
+            texture[rows[sel]] = table.materials[m].texture.color(p_sel, uv)

@@ -1,0 +1,45 @@
+"""Materials: the coefficients of the shading equation, and a table of them by index.
+
+`MaterialTable` gathers every material's coefficients into arrays, so shading all
+hits is one vectorized expression indexed by each hit's material.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def _rgb(x) -> np.ndarray:
+    return np.broadcast_to(np.asarray(x, dtype=float), (3,)).copy()
+
+
+@dataclass(frozen=True)
+class Material:
+    ambient: np.ndarray = field(default_factory=lambda: _rgb(0.1))      # ka
+    diffuse: np.ndarray = field(default_factory=lambda: _rgb(0.9))      # kd
+    specular: np.ndarray = field(default_factory=lambda: _rgb(0.0))     # ks
+    shininess: float = 32.0                                             # n, the specular exponent
+    emission: np.ndarray = field(default_factory=lambda: _rgb(0.0))     # added as is (002)
+    reflection: np.ndarray = field(default_factory=lambda: _rgb(0.0))   # kr, weight of the mirror ray
+    transmission: np.ndarray = field(default_factory=lambda: _rgb(0.0)) # kt, weight of the refracted ray
+    ior: float = 1.0                                                    # index of refraction inside
+    shadow: bool = True                                                 # casts a shadow
+    texture: object = None                                              # Checker, ImageTexture or None
+
+
+class MaterialTable:
+    """Per-coefficient arrays, row k = material k."""
+
+    def __init__(self, materials: list[Material]):
+        self.materials = list(materials)
+        stack = lambda name: np.array([getattr(m, name) for m in materials], dtype=float)
+        self.ka, self.kd, self.ks = stack("ambient"), stack("diffuse"), stack("specular")
+        self.n, self.emission = stack("shininess"), stack("emission")
+        self.kr, self.kt, self.ior = stack("reflection"), stack("transmission"), stack("ior")
+        self.shadow = np.array([m.shadow for m in materials], dtype=bool)
+        self.textured = [k for k, m in enumerate(materials) if m.texture is not None]
+
+    def __len__(self) -> int:
+        return len(self.materials)

@@ -1,0 +1,233 @@
+"""Typed, located access to one YAML mapping of a scene (pbrt's ParameterDictionary).
+
+Every getter checks the type, reports errors as `file:line:col: key.path: message`,
+and remembers the key as read; `check_unused()` then reports the first key
+nobody read, which catches typos such as `raduis:`.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+
+import numpy as np
+
+from rtcli.errors import SceneError, Where
+from rtcli.yamlfile import MapNode, SeqNode
+
+REQUIRED = object()
+
+
+def _is_number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def describe(x) -> str:
+    """How a wrong value is shown in a message."""
+    if isinstance(x, MapNode):
+        return "a mapping"
+    if isinstance(x, SeqNode):
+        return f"a list of {len(x)}"
+    if isinstance(x, str):
+        return repr(x)
+    if x is None:
+        return "nothing"
+    return str(x).lower() if isinstance(x, bool) else repr(x)
+
+
+class Params:
+    """The keys of one mapping, read through typed getters."""
+
+    def __init__(self, node: MapNode, path: str):
+        if not isinstance(node, MapNode):
+            raise TypeError("Params needs a MapNode")
+        self.node, self.path, self.read = node, path, set()
+
+    # --- locations and errors ---
+    @property
+    def folder(self) -> str:
+        return self.node.folder
+
+    @property
+    def where(self) -> Where:
+        return self.node.where
+
+    def key_path(self, key: str) -> str:
+        return f"{self.path}.{key}" if self.path else key
+
+    def error(self, key: str | None, message: str) -> SceneError:
+        """An error located at `key`'s value (or at the mapping when key is None)."""
+        if key is None:
+            return SceneError(self.node.where, self.path, message)
+        return SceneError(self.node.value_where.get(key, self.node.where), self.key_path(key), message)
+
+    def has(self, key: str) -> bool:
+        return key in self.node
+
+    def raw(self, key: str, default=REQUIRED):
+        """The value as loaded, marked read; a missing required key is an error."""
+        self.read.add(key)
+        if key not in self.node:
+            if default is REQUIRED:
+                raise SceneError(self.node.where, self.key_path(key), "missing required key")
+            return default
+        return self.node[key]
+
+    def check_unused(self) -> None:
+        for key in self.node:
+            if key not in self.read:
+                close = difflib.get_close_matches(key, sorted(self.read), n=1)
+                hint = f" (did you mean '{close[0]}'?)" if close else ""
+                raise SceneError(self.node.key_where[key], self.key_path(key), f"unknown key{hint}")
+
+    # --- typed getters ---
+    def number(self, key, default=REQUIRED, *, positive=False, non_negative=False) -> float:
+        x = self.raw(key, default)
+        if x is default and default is not REQUIRED:
+            return x
+        self._check_number(key, x, positive, non_negative)
+        return float(x)
+
+    def _check_number(self, key, x, positive=False, non_negative=False, what="a number"):
+        if not _is_number(x):
+            raise self.error(key, f"must be {what}, got {describe(x)}")
+        if not math.isfinite(x):
+            raise self.error(key, f"must be finite, got {x}")
+        if positive and x <= 0:
+            raise self.error(key, f"must be > 0, got {x:g}")
+        if non_negative and x < 0:
+            raise self.error(key, f"must be >= 0, got {x:g}")
+
+    def integer(self, key, default=REQUIRED, lo=None, hi=None) -> int:
+        x = self.raw(key, default)
+        if x is default and default is not REQUIRED:
+            return x
+        if not isinstance(x, int) or isinstance(x, bool):
+            raise self.error(key, f"must be an integer, got {describe(x)}")
+        if (lo is not None and x < lo) or (hi is not None and x > hi):
+            raise self.error(key, f"must be in {lo}..{hi}, got {x}")
+        return x
+
+    def boolean(self, key, default=REQUIRED) -> bool:
+        x = self.raw(key, default)
+        if not isinstance(x, bool):
+            raise self.error(key, f"must be true or false, got {describe(x)}")
+        return x
+
+    def string(self, key, default=REQUIRED) -> str:
+        x = self.raw(key, default)
+        if x is default and default is not REQUIRED:
+            return x
+        if not isinstance(x, str):
+            raise self.error(key, f"must be a string, got {describe(x)}")
+        return x
+
+    def choice(self, key, options, default=REQUIRED) -> str:
+        x = self.string(key, default)
+        if x not in options:
+            raise self.error(key, f"must be one of {', '.join(options)}, got {describe(x)}")
+        return x
+
+    def numbers(self, key, count, default=REQUIRED, what="a vector") -> np.ndarray:
+        """A list of exactly `count` finite numbers."""
+        x = self.raw(key, default)
+        if x is default and default is not REQUIRED:
+            return np.array(x, dtype=float)
+        return self.numbers_value(key, x, count, what)
+
+    def numbers_value(self, key, x, count, what="a vector", label=None) -> np.ndarray:
+        label = label or self.key_path(key)
+        where = self.node.value_where.get(key, self.node.where)
+        if not isinstance(x, list) or len(x) != count:
+            raise SceneError(where, label, f"must be {what} of {count} numbers, got {describe(x)}")
+        for k, v in enumerate(x):
+            item_where = x.item_where[k] if isinstance(x, SeqNode) else where
+            if not _is_number(v) or not math.isfinite(v):
+                raise SceneError(item_where, f"{label}[{k}]", f"must be a finite number, got {describe(v)}")
+        return np.array(x, dtype=float)
+
+    def vector(self, key, default=REQUIRED) -> np.ndarray:
+        return self.numbers(key, 3, default, "a vector [x, y, z]")
+
+    def vectors(self, key, min_count=1, count=None, default=REQUIRED) -> np.ndarray:
+        """A list of vectors, shape (k, 3)."""
+        x = self.raw(key, default)
+        if x is default and default is not REQUIRED:
+            return x
+        where = self.node.value_where.get(key, self.node.where)
+        if not isinstance(x, list) or len(x) < min_count or (count and len(x) != count):
+            need = f"{count}" if count else f"at least {min_count}"
+            raise SceneError(where, self.key_path(key), f"must be a list of {need} vectors, got {describe(x)}")
+        rows = []
+        for k, v in enumerate(x):
+            rows.append(self._item_numbers(x, k, v, 3, "a vector [x, y, z]", f"{self.key_path(key)}[{k}]"))
+        return np.array(rows, dtype=float).reshape(-1, 3)
+
+    def _item_numbers(self, seq, k, v, count, what, label) -> np.ndarray:
+        where = seq.item_where[k] if isinstance(seq, SeqNode) else self.node.where
+        if not isinstance(v, list) or len(v) != count:
+            raise SceneError(where, label, f"must be {what}, got {describe(v)}")
+        for m, w in enumerate(v):
+            w_where = v.item_where[m] if isinstance(v, SeqNode) else where
+            if not _is_number(w) or not math.isfinite(w):
+                raise SceneError(w_where, f"{label}[{m}]", f"must be a finite number, got {describe(w)}")
+        return np.array(v, dtype=float)
+
+    def color(self, key, default=REQUIRED) -> np.ndarray:
+        """[r, g, b] of non-negative floats, or "#rrggbb"."""
+        x = self.raw(key, default)
+        if x is default and default is not REQUIRED:
+            return np.array(x, dtype=float)
+        return self.color_value(key, x, self.key_path(key), self.node.value_where.get(key, self.node.where))
+
+    def color_value(self, key, x, label, where, allow_scalar=False) -> np.ndarray:
+        if isinstance(x, str):
+            if len(x) == 7 and x[0] == "#":
+                try:
+                    return np.array([int(x[i:i + 2], 16) / 255 for i in (1, 3, 5)])
+                except ValueError:
+                    pass
+            raise SceneError(where, label, f"must be a color [r, g, b] or \"#rrggbb\", got {describe(x)}")
+        if allow_scalar and _is_number(x):
+            x = [x, x, x]
+        if not isinstance(x, list) or len(x) != 3:
+            raise SceneError(where, label, f"must be a color [r, g, b] or \"#rrggbb\", got {describe(x)}")
+        for k, v in enumerate(x):
+            item_where = x.item_where[k] if isinstance(x, SeqNode) else where
+            if not _is_number(v) or not math.isfinite(v) or v < 0:
+                raise SceneError(item_where, f"{label}[{k}]",
+                                 f"must be a finite number >= 0, got {describe(v)}")
+        return np.array(x, dtype=float)
+
+    def coefficient(self, key, default=REQUIRED) -> np.ndarray:
+        """A color or one number k meaning [k, k, k]."""
+        x = self.raw(key, default)
+        if x is default and default is not REQUIRED:
+            return np.broadcast_to(np.array(x, dtype=float), (3,)).copy()
+        return self.color_value(key, x, self.key_path(key),
+                                self.node.value_where.get(key, self.node.where), allow_scalar=True)
+
+    def sub(self, key, default=REQUIRED) -> Params | None:
+        """The nested mapping at `key` as Params."""
+        x = self.raw(key, default)
+        if x is None and default is None:
+            return None
+        if not isinstance(x, MapNode):
+            raise self.error(key, f"must be a mapping of keys, got {describe(x)}")
+        return Params(x, self.key_path(key))
+
+    def items(self, key, default=REQUIRED) -> list[tuple[object, Where, str]]:
+        """The list at `key` as (item, where, path) triples."""
+        x = self.raw(key, default)
+        if x is default and default is not REQUIRED:
+            return []
+        if not isinstance(x, SeqNode):
+            raise self.error(key, f"must be a list, got {describe(x)}")
+        return [(v, x.item_where[k], f"{self.key_path(key)}[{k}]") for k, v in enumerate(x)]
+
+
+def as_params(item, where: Where, path: str, what: str = "a mapping of keys") -> Params:
+    """Params for a list item, or an error if the item is not a mapping."""
+    if not isinstance(item, MapNode):
+        raise SceneError(where, path, f"must be {what}, got {describe(item)}")
+    return Params(item, path)

@@ -1,0 +1,131 @@
+"""From a scene to a float image: the pixel loop of notes 000 11.7 and 002, in tiles.
+
+The image is cut into tiles, each traced as one wavefront of rays, so memory is
+bounded by the tile size whatever the image size. Tiles go to worker processes;
+every pixel's value depends only on the pixel (jitter is hashed from its
+coordinates), so the image is the same for any tile size and worker count.
+With `block_size` B, one ray goes through the top-left pixel of each B x B block
+and the whole block gets its color (002's raytrace loop).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from rtcli.intersect import find_first_hit
+from rtcli.jitter import uniform
+from rtcli.scene import Scene
+from rtcli.stats import Stats
+from rtcli.trace import trace
+from rtcli.writer import to_8bit
+
+TILE = 64                                  # tile edge in pixels (rays per tile: TILE^2 x samples^2)
+
+
+@dataclass(frozen=True)
+class Job:
+    """What to render: the output size, the preview block and the tile edge."""
+
+    width: int
+    height: int
+    block_size: int = 1
+    tile: int = TILE
+    signature: bool = False          # trace primary rays only and return object ids
+    gamma: bool = False              # sRGB-encode when converting to 8 bits
+
+
+def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n x n stratified, jittered sample positions per pixel, shape (n*n, len(i)) each.
+
+    With n = 1 the single sample is the pixel centre (i + 0.5, j + 0.5).
+    """
+    if n == 1:
+        return (i + 0.5)[None, :], (j + 0.5)[None, :]
+    xs, ys = [], []
+    for cell in range(n * n):
+        a, b = divmod(cell, n)
+        xs.append(i + (b + uniform(i, j, cell, 0)) / n)
+        ys.append(j + (a + uniform(i, j, cell, 1)) / n)
+    return np.array(xs), np.array(ys)
+
+
+def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, Stats]:
+    """Colors (or ids) of the pixels (i, j) of the full-size image."""
+    stats = Stats()
+    cam = scene.camera(job.width, job.height)
+    if job.signature:
+        rays = cam.rays(i + 0.5, j + 0.5, job.width, job.height)
+        hits = find_first_hit(scene, rays)
+        stats.primary += len(rays)
+        ids = np.array([o.id for o in scene.objects] + [0], dtype=np.uint16)
+        return ids[hits.obj], stats
+    xs, ys = sample_positions(i, j, scene.settings.samples)
+    rays = cam.rays(xs.ravel(), ys.ravel(), job.width, job.height)
+    stats.primary += len(rays)
+    colors = trace(scene, rays, 1, stats).reshape(len(xs), len(i), 3)
+    return colors.mean(axis=0), stats
+
+
+def _tiles(job: Job):
+    """(rows, cols) index ranges of the traced grid: every pixel, or each block's top-left."""
+    b = job.block_size
+    rows, cols = np.arange(0, job.height, b), np.arange(0, job.width, b)
+    for r in range(0, len(rows), job.tile):
+        for c in range(0, len(cols), job.tile):
+            yield rows[r:r + job.tile], cols[c:c + job.tile]
+
+
+def _run_tile(scene: Scene, job: Job, rows: np.ndarray, cols: np.ndarray):
+    jj, ii = np.meshgrid(rows, cols, indexing="ij")
+    values, stats = render_tile(scene, job, ii.ravel(), jj.ravel())
+    return rows, cols, values.reshape(len(rows), len(cols), *values.shape[1:]), stats
+
+
+_worker_scene = None                       # the scene, sent once to each worker process
+
+
+def _init_worker(scene: Scene) -> None:
+    global _worker_scene
+    _worker_scene = scene
+
+
+def _worker_tile(job: Job, rows, cols):
+    return _run_tile(_worker_scene, job, rows, cols)
+
+
+def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.ndarray, Stats]:
+    """The 8-bit image (H, W, 3), or the id map (H, W) uint16 for a signature.
+
+    Tiles are converted to 8 bits as they arrive, so no float copy of the whole image exists.
+    """
+    b = job.block_size
+    shape = (job.height, job.width) + (() if job.signature else (3,))
+    image = np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
+    stats, tiles = Stats(), list(_tiles(job))
+    for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, job, tiles, workers), 1):
+        if not job.signature:
+            values = to_8bit(values, job.gamma)
+        block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
+        image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
+        stats.add(s)
+        if progress:
+            progress(done, len(tiles))
+    return image, stats
+
+
+def _map_tiles(scene: Scene, job: Job, tiles: list, workers: int):
+    if workers <= 1 or len(tiles) == 1:
+        for rows, cols in tiles:
+            yield _run_tile(scene, job, rows, cols)
+        return
+    context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
+    with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
+                             initargs=(scene,)) as pool:
+        futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
+        for f in futures:
+            yield f.result()

@@ -1,0 +1,69 @@
+"""The scene model: plain data built by build.py, read by the core. Picklable."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rtcli.materials import MaterialTable
+from rtcli.transform import Transform, bounds_of_box
+
+
+@dataclass
+class SceneObject:
+    id: int                          # 1, 2, 3 ... in file order (signature ids)
+    name: str
+    shape: object                    # a shape of rtcli.shapes, in object space
+    material: int                    # row of the scene's MaterialTable
+    world_from_object: Transform | None = None     # None: object space is world space
+    kind: str = ""                   # the YAML shape name, for legends
+
+    def to_object(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The ray in object space: inverse-transformed start and direction (notes 000 11.3.4)."""
+        if self.world_from_object is None:
+            return o, d
+        inv = self.world_from_object.inverse
+        return inv.point(o), inv.vector(d)
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray] | None:
+        b = self.shape.bounds()
+        if b is None or self.world_from_object is None:
+            return b
+        return bounds_of_box(self.world_from_object, *b)
+
+
+@dataclass
+class Settings:
+    width: int = 640                 # nc
+    height: int = 480                # nr
+    max_depth: int = 5               # rays per path, the primary included
+    specular: str = "phong"          # phong: (R.V)^n, blinn: (N.H)^n
+    samples: int = 1                 # n x n per pixel
+    epsilon: float = 1e-6            # self-intersection offset, relative to the scene's size
+
+
+@dataclass
+class Scene:
+    camera: object                   # callable (nc, nr) -> camera.Camera
+    objects: list[SceneObject]
+    materials: MaterialTable
+    lights: list = field(default_factory=list)
+    background: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    ambient: np.ndarray = field(default_factory=lambda: np.full(3, 0.1))      # Ia
+    settings: Settings = field(default_factory=Settings)
+    eye: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    accel: object = None             # rtcli.accel.Accelerator, built by prepare()
+
+    @property
+    def size(self) -> float:
+        """A length for the scene's scale: the diagonal of its bounded objects and the eye."""
+        boxes = [b for b in (o.bounds() for o in self.objects) if b is not None]
+        lo = np.min([self.eye] + [b[0] for b in boxes], axis=0)
+        hi = np.max([self.eye] + [b[1] for b in boxes], axis=0)
+        return max(float(np.linalg.norm(hi - lo)), 1e-3)
+
+    @property
+    def offset(self) -> float:
+        """World-space distance a spawned ray starts off its surface."""
+        return self.settings.epsilon * self.size

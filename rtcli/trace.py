@@ -1,0 +1,55 @@
+"""rayTrace() of notes 000 11.7, on whole arrays of rays.
+
+    color = local(p)                                   (shade.py)
+          + kr * trace(mirror ray)     if depth < max_depth and kr > 0
+          + kt * trace(refracted ray)  if depth < max_depth and kt > 0 and no total internal reflection
+
+Each branch recurses on the compacted subset of rays that need it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rtcli.intersect import find_first_hit, surface
+from rtcli.rays import Rays
+from rtcli.scene import Scene
+from rtcli.shade import local
+from rtcli.stats import Stats
+from rtcli.vec import normalize, reflect, refract
+
+
+def trace(scene: Scene, rays: Rays, depth: int, stats: Stats) -> np.ndarray:
+    """Color seen along each ray; depth 1 is the primary ray."""
+    color = np.tile(scene.background, (len(rays), 1))
+    hits = find_first_hit(scene, rays)
+    seen = np.flatnonzero(np.isfinite(hits.t))
+    if len(seen):
+        color[seen] = shade(scene, rays[seen], surface(scene, rays[seen], hits[seen]), depth, stats)
+    return color
+
+
+def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats) -> np.ndarray:
+    """rtShade: the local term plus the mirror and refracted rays (global term)."""
+    color = local(scene, rays, s, stats)
+    if depth >= scene.settings.max_depth:
+        return color
+    table, D = scene.materials, normalize(rays.direction)
+    kr, kt = table.kr[s.material], table.kt[s.material]
+    eps = scene.offset * s.ng                            # step off the surface, to the ray's side
+    mirror = np.flatnonzero(kr.max(axis=1) > 0)
+    if len(mirror):
+        stats.reflected += len(mirror)
+        ms = reflect(D[mirror], s.n[mirror])             # ms = d - 2 (d.n) n
+        color[mirror] += kr[mirror] * trace(scene, Rays(s.p[mirror] + eps[mirror], ms), depth + 1, stats)
+    clear = np.flatnonzero(kt.max(axis=1) > 0)
+    if len(clear):
+        ior = table.ior[s.material[clear]]
+        eta = np.where(s.entering[clear], 1.0 / ior, ior)  # 1 -> ior entering, ior -> 1 leaving
+        t_dir, tir = refract(D[clear], s.n[clear], eta)
+        go = clear[~tir]
+        stats.refracted += len(go)
+        if len(go):
+            rays_t = Rays(s.p[go] - eps[go], t_dir[~tir])
+            color[go] += kt[go] * trace(scene, rays_t, depth + 1, stats)
+    return color
