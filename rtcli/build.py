@@ -29,27 +29,24 @@ def load_scene(path: str) -> Scene:
 
 def scene_from_docs(docs: list) -> Scene:
     """Included documents first, the main file last; only the main file sets camera and image."""
-    main = Params(docs[-1], "")
-    for doc in docs:
-        p = main if doc is docs[-1] else Params(doc, "")
+    params = [Params(doc, "") for doc in docs]
+    main = params[-1]
+    for p in params:
         if p.has("version") and p.raw("version") != 1:
             raise p.error("version", f"unsupported version {p.raw('version')!r} (this is version 1)")
         p.read.update(("version", "include"))
     named, table = {}, [Material()]
-    for doc in docs:
-        p = main if doc is docs[-1] else Params(doc, "")
+    for p in params:
         for name, mp in _materials(p):
             named[name] = len(table)
             table.append(material_from(mp))
-    builder = ObjectBuilder(named, table, 0)
-    lights = []
-    for doc in docs:
-        p = main if doc is docs[-1] else Params(doc, "")
+    builder, lights = ObjectBuilder(named, table, 0), []
+    for p in params:
         lights += [light_from(as_params(item, where, path, "a light mapping"))
                    for item, where, path in p.items("lights", [])]
         builder.add_all(p.items("objects", []))
-        if doc is not docs[-1]:
-            p.check_unused()
+    for p in params[:-1]:
+        p.check_unused()
     scene = _top_level(main, builder, lights, table)
     main.check_unused()
     return scene
