@@ -32,10 +32,10 @@ def to_8bit(image: np.ndarray, gamma: bool = False) -> np.ndarray:
 
 def write_png(path: str, pixels: np.ndarray) -> None:
     """Write uint8 (H, W, 3) as RGB or uint16 (H, W) as 16-bit gray, atomically."""
-    if pixels.dtype == np.uint16:
-        img = Image.fromarray(pixels, mode="I;16") if pixels.ndim == 2 else None
-    else:
-        img = Image.fromarray(pixels, mode="RGB")
+    if not ((pixels.dtype == np.uint16 and pixels.ndim == 2)
+            or (pixels.dtype == np.uint8 and pixels.ndim == 3 and pixels.shape[2] == 3)):
+        raise ValueError(f"cannot write {pixels.dtype} pixels of shape {pixels.shape} as PNG")
+    img = Image.fromarray(pixels)                      # uint16 (H, W) -> I;16, uint8 (H, W, 3) -> RGB
     folder = os.path.dirname(os.path.abspath(path))
     try:
         fd, tmp = tempfile.mkstemp(prefix=".rtcli-", suffix=".png", dir=folder)
