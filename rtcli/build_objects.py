@@ -173,16 +173,16 @@ class ObjectBuilder:
             self.add_all(g.items("objects"), world, material)
             g.check_unused()
         else:
-            shape = self.shape(p, kind)
+            shape = self.shape(p, kind, material)
             self.objects.append(SceneObject(len(self.objects) + 1, p.node.get("name", ""), shape,
                                             material, world, kind))
         p.check_unused()
 
-    def shape(self, p: Params, kind: str):
+    def shape(self, p: Params, kind: str, material: int):
         sp = self._shape_params(p, kind)
         if kind == "csg":
             from rtcli.shapes.csg import csg_from
-            shape = csg_from(sp, self)
+            shape = csg_from(sp, self, material)
         else:
             shape = SHAPES[kind].from_params(sp)
         sp.check_unused()
@@ -196,7 +196,7 @@ class ObjectBuilder:
         p.string("name", "")
         t = transform_from(p)
         material = material_ref(p, "material", self.named, self.table, inherited)
-        shape = self.shape(p, kind)
+        shape = self.shape(p, kind, material)
         p.check_unused()
         return shape, t, material
 
