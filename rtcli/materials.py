@@ -17,8 +17,8 @@ def _rgb(x) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Material:
-    ambient: np.ndarray = field(default_factory=lambda: _rgb(0.1))      # ka
-    diffuse: np.ndarray = field(default_factory=lambda: _rgb(0.9))      # kd
+    ambient: np.ndarray = field(default_factory=lambda: _rgb(0.8))      # ka (build: the diffuse color)
+    diffuse: np.ndarray = field(default_factory=lambda: _rgb(0.8))      # kd
     specular: np.ndarray = field(default_factory=lambda: _rgb(0.0))     # ks
     shininess: float = 32.0                                             # n, the specular exponent
     emission: np.ndarray = field(default_factory=lambda: _rgb(0.0))     # added as is (002)
