@@ -1,0 +1,122 @@
+"""rtcli against POV-Ray 3.7 on the reference scenes, side by side in one run.
+
+For each scene and size, rtcli and POV-Ray (when `povray` is on PATH) render
+alternately, `--runs` times each, every run a whole process timed by wall clock
+as a user sees it. The table gives the medians, their ratio (rtcli / POV-Ray;
+below 1 means rtcli is faster) and rtcli's rays per second. Each rtcli image is
+then checked against POV-Ray's with a loose gate, and the share of pixels that
+differ by more than 10% in some channel is reported: the pictures should show
+the same objects, lights and shadows.
+
+    python bench/run.py [--runs 3] [--sizes 640x480,1920x1080] [--scenes whitted,quadrics]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+from PIL import Image
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCENES = ["whitted", "quadrics", "spheres1k", "torus100k"]
+
+
+def timed(cmd: list[str], cwd: str) -> tuple[float, str]:
+    start = time.perf_counter()
+    done = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    if done.returncode != 0:
+        sys.exit(f"failed ({done.returncode}): {' '.join(cmd)}\n{done.stderr[-2000:]}")
+    return seconds, done.stdout
+
+
+def rtcli_cmd(scene, out, w, h, workers):
+    return [sys.executable, "-m", "rtcli", "render", f"{scene}.yaml", "-o", out,
+            "--width", str(w), "--height", str(h), "--quiet", "--stats", "--workers", str(workers)]
+
+
+def povray_cmd(scene, out, w, h, workers):
+    return ["povray", f"+I{scene}.pov", f"+O{out}", f"+W{w}", f"+H{h}", "-D", "-A",
+            f"+WT{workers}", "File_Gamma=1.0", "-V", "-GA"]
+
+
+def differing_share(a_path: str, b_path: str) -> float:
+    a = np.asarray(Image.open(a_path).convert("RGB"), dtype=int)
+    b = np.asarray(Image.open(b_path).convert("RGB"), dtype=int)
+    if a.shape != b.shape:
+        return float("nan")
+    return float(np.mean(np.abs(a - b).max(axis=2) > 25))
+
+
+def framed_like_povray(scene: str, w: int, h: int) -> str:
+    """The scene's YAML name, or a copy whose vertical fov gives POV-Ray's framing at w x h.
+
+    POV-Ray's `angle` fixes the horizontal field of view and rtcli's `fov` the
+    vertical one; they agree at the scene's own aspect ratio (4:3).
+    """
+    text = open(os.path.join(HERE, f"{scene}.yaml")).read()
+    match = re.search(r"fov: ([0-9.]+)", text)
+    size = re.search(r"image: \{width: (\d+), height: (\d+)\}", text)
+    w0, h0 = int(size.group(1)), int(size.group(2))
+    if match is None or w * h0 == h * w0:
+        return scene
+    tan_h = np.tan(np.radians(float(match.group(1))) / 2) * w0 / h0
+    fov = np.degrees(2 * np.arctan(tan_h * h / w))
+    name = f".{scene}_{w}x{h}"
+    with open(os.path.join(HERE, f"{name}.yaml"), "w") as f:
+        f.write(text.replace(match.group(0), f"fov: {fov:.4f}"))
+    return name
+
+
+def bench(scene, w, h, runs, workers, tmp, pov):
+    rt_scene = framed_like_povray(scene, w, h)
+    rt_out, pov_out = os.path.join(tmp, f"{scene}_rt.png"), os.path.join(tmp, f"{scene}_pov.png")
+    rt_times, pov_times, rays = [], [], 0
+    for _ in range(runs):
+        seconds, stdout = timed(rtcli_cmd(rt_scene, rt_out, w, h, workers), HERE)
+        rt_times.append(seconds)
+        rays = int(re.search(r"(\d+) total", stdout).group(1))
+        if pov:
+            pov_times.append(timed(povray_cmd(scene, pov_out, w, h, workers), HERE)[0])
+    if rt_scene != scene:
+        os.remove(os.path.join(HERE, f"{rt_scene}.yaml"))
+    rt = statistics.median(rt_times)
+    pv = statistics.median(pov_times) if pov else float("nan")
+    share = differing_share(rt_out, pov_out) if pov else float("nan")
+    return rt, pv, rays / rt, share
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--sizes", default="640x480,1920x1080")
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--keep", help="folder to keep the rendered images in")
+    args = ap.parse_args()
+    pov = shutil.which("povray") is not None
+    if not pov:
+        print("povray not found (apt-get install povray): timing rtcli alone")
+    tmp = args.keep or tempfile.mkdtemp(prefix="rtcli-bench-")
+    os.makedirs(tmp, exist_ok=True)
+    print(f"{'scene':<10} {'size':>9} {'rtcli s':>8} {'POV-Ray s':>9} {'ratio':>6} {'rtcli rays/s':>13} {'differ':>7}")
+    for scene in args.scenes.split(","):
+        for size in args.sizes.split(","):
+            w, h = (int(x) for x in size.split("x"))
+            rt, pv, rate, share = bench(scene, w, h, args.runs, args.workers, tmp, pov)
+            print(f"{scene:<10} {size:>9} {rt:8.2f} {pv:9.2f} {rt / pv:6.2f} {rate:13,.0f} {share:7.1%}",
+                  flush=True)
+    print(f"images in {tmp}")
+
+
+if __name__ == "__main__":
+    main()
