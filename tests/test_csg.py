@@ -114,4 +114,4 @@ def test_csg_of_a_triangle_is_an_error(yaml_scene):
                     - {triangle: {vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]}}
         """)
     assert str(e.value).endswith("objects[0].csg.union[1]: a csg child must be a solid: "
-                                 "sphere, plane, box, cylinder, cone, torus or csg")
+                                 "sphere, plane, box, cylinder, cone (capped), torus or csg")

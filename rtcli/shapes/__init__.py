@@ -16,8 +16,11 @@ Shapes that model a solid also offer, for CSG,
 Optional: geometric_normal(p, prim) when the shading normal differs (smooth triangles).
 """
 
+from rtcli.shapes.box import Box
 from rtcli.shapes.planar import Plane, Polygon, Square, Triangle
+from rtcli.shapes.quadric import Cone, Cylinder
 from rtcli.shapes.sphere import Sphere
+from rtcli.shapes.torus import Torus
 
 SHAPES = {
     "sphere": Sphere,
@@ -25,4 +28,8 @@ SHAPES = {
     "triangle": Triangle,
     "polygon": Polygon,
     "square": Square,
+    "box": Box,
+    "cylinder": Cylinder,
+    "cone": Cone,
+    "torus": Torus,
 }

@@ -50,8 +50,9 @@ def csg_from(p, builder, material: int) -> "CSG":
     for item, where, path in items:
         cp = as_params(item, where, path, "an object (a mapping with a shape key)")
         shape, t, mat = builder.child(cp, material)
-        if not hasattr(shape, "spans"):
-            raise cp.error(None, "a csg child must be a solid: sphere, plane, box, cylinder, cone, torus or csg")
+        if not hasattr(shape, "spans") or not getattr(shape, "capped", True):
+            raise cp.error(None, "a csg child must be a solid: sphere, plane, box, "
+                           "cylinder, cone (capped), torus or csg")
         children.append(Child(shape, t, mat))
     return CSG(ops[0], children)
 
