@@ -17,6 +17,7 @@ Optional: geometric_normal(p, prim) when the shading normal differs (smooth tria
 """
 
 from rtcli.shapes.box import Box
+from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.planar import Plane, Polygon, Square, Triangle
 from rtcli.shapes.quadric import Cone, Cylinder
 from rtcli.shapes.sphere import Sphere
@@ -32,4 +33,5 @@ SHAPES = {
     "cylinder": Cylinder,
     "cone": Cone,
     "torus": Torus,
+    "mesh": Mesh,
 }

@@ -1,0 +1,211 @@
+"""Bounding volume hierarchy over boxes: binned SAH build, traversal by whole arrays of rays.
+
+Why: a mesh of 100k triangles (or a scene of 1k spheres) is too many primitives
+to test every ray against each one. The BVH is generic: it knows only the
+primitives' boxes; the caller supplies the exact (ray, primitive) test.
+
+Build (pbrt-v4's binned SAH, done one tree level at a time so numpy handles all
+nodes of a level together): each node's primitives are binned by centroid on
+each axis, and the split between bins with least N_L A_L + N_R A_R (A = half
+surface area) is taken; nodes with <= leaf_size primitives become leaves. When
+all centroids coincide, a node is halved by count.
+
+Storage (flat arrays, node 0 is the root): lo/hi (3, k) node boxes (per axis), child (k,)
+index of the left child (the right one is child + 1) or -1 for a leaf,
+start/count (k,) a leaf's range in perm, perm (m,) primitive indices.
+
+Traversal: a frontier of (ray, node) pairs, one tree level per step. All pairs
+are slab-tested at once, with each ray's best t so far as the far limit; leaf
+pairs become (ray, primitive) pairs for the caller's test, which lowers the
+rays' best t so later levels prune; interior pairs expand to both children.
+Rays are processed in chunks to bound memory.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+CHUNK = 1 << 13                         # rays traversed together
+PAD = 1e-9                              # node boxes grow by PAD x scene size, so rounding in the slab
+                                        # test cannot drop a hit lying on a box face
+
+
+class BVH:
+    """BVH over m primitive boxes lo, hi (m, 3); see the module docstring."""
+
+    def __init__(self, lo: np.ndarray, hi: np.ndarray, leaf_size: int = 4, bins: int = 12):
+        lo, hi = (np.asarray(x, dtype=float).reshape(-1, 3) for x in (lo, hi))
+        self.m = len(lo)
+        if self.m == 0:
+            self.box = (np.full(3, np.inf), np.full(3, -np.inf))
+            return
+        self.box = (lo.min(axis=0), hi.max(axis=0))
+        self.lo, self.hi, self.child, self.start, self.count, self.perm = _build(lo, hi, leaf_size, bins)
+        pad = PAD * max(np.abs(np.concatenate(self.box)).max(), np.finfo(float).tiny)
+        self.lo, self.hi = np.ascontiguousarray((self.lo - pad).T), np.ascontiguousarray((self.hi + pad).T)
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The union of the primitives' boxes (inf, -inf when there are none)."""
+        return self.box[0].copy(), self.box[1].copy()
+
+    def intersect(self, o, d, t_min, t_max, hit_pairs):
+        """Nearest primitive along each ray: (t (n,), prim (n,)), inf and -1 for a miss.
+
+        hit_pairs(rays, prims, t_max_pairs) -> t (p,) is the exact test of
+        (ray, primitive) pairs: a hit in (t_min, t_max_pairs), else inf. The
+        result equals that test run on every primitive (ties: lowest t, any prim).
+        """
+        n = len(o)
+        best = np.broadcast_to(np.asarray(t_max, dtype=float), (n,)).copy()
+        prim = np.full(n, -1, dtype=np.int64)
+
+        def leaves(r, p):
+            t = hit_pairs(r, p, best[r])
+            hit = t < best[r]
+            r, p, t = r[hit], p[hit], t[hit]
+            np.minimum.at(best, r, t)                  # each ray's nearest among these pairs
+            won = t == best[r]
+            prim[r[won]] = p[won]
+
+        self._traverse(o, d, t_min, best, leaves)
+        return np.where(prim >= 0, best, np.inf), prim
+
+    def any_hit(self, o, d, t_min, t_max, hit_pairs) -> np.ndarray:
+        """(n,) bool: some primitive is hit in (t_min, t_max) (shadow feelers); blocked rays stop."""
+        far = np.broadcast_to(np.asarray(t_max, dtype=float), (len(o),)).copy()
+
+        def leaves(r, p):
+            t = hit_pairs(r, p, far[r])
+            far[r[np.isfinite(t)]] = np.nan            # NaN fails every later slab test
+
+        self._traverse(o, d, t_min, far, leaves)
+        return np.isnan(far)
+
+    def _traverse(self, o, d, t_min, far, leaves):
+        """Walk the (ray, node) frontier level by level; far (n,) is read live for pruning."""
+        if self.m == 0 or len(o) == 0:
+            return
+        n, t_min = len(o), np.asarray(t_min, dtype=float)
+        o = np.ascontiguousarray(np.asarray(o, dtype=float).T)   # per axis, so the slab test runs on 1-D columns
+        with np.errstate(divide="ignore"):
+            inv = 1.0 / np.ascontiguousarray(np.asarray(d, dtype=float).T)   # +-inf for zero components
+        for s in range(0, n, CHUNK):
+            rays = np.arange(s, min(s + CHUNK, n))
+            rays = rays[self._slab(o[:, rays], inv[:, rays], 0, _at(t_min, rays), far[rays])]
+            nodes = np.zeros(len(rays), dtype=np.int64)                              # the root
+            while len(rays):
+                leaf = self.child[nodes] < 0
+                if leaf.any():
+                    leaves(*self._leaf_pairs(rays[leaf], nodes[leaf]))
+                rays, nodes = rays[~leaf], self.child[nodes[~leaf]]
+                rays, nodes = self._children(o, inv, t_min, far, rays, nodes)
+
+    def _children(self, o, inv, t_min, far, rays, left):
+        """The (ray, child) pairs whose child box the ray meets, for both children of each pair's node."""
+        o_r, inv_r, near, far_r = o[:, rays], inv[:, rays], _at(t_min, rays), far[rays]
+        hit_l = self._slab(o_r, inv_r, left, near, far_r)
+        hit_r = self._slab(o_r, inv_r, left + 1, near, far_r)
+        return np.concatenate([rays[hit_l], rays[hit_r]]), np.concatenate([left[hit_l], left[hit_r] + 1])
+
+    def _slab(self, o, inv, nodes, t_min, t_max):
+        """Kay-Kajiya slab test of (ray, node) pairs against [t_min, t_max].
+
+        A zero direction component gives +-inf, and NaN (0 x inf) when the
+        origin lies on that slab's plane: the ray then runs inside the closed
+        slab, so NaN must not constrain; np.minimum/maximum keep the NaN and
+        np.fmax/fmin then skip it. A NaN t_max (a blocked ray) fails.
+        """
+        t_in, t_out = t_min, np.inf
+        with np.errstate(invalid="ignore"):
+            for k in range(3):
+                t1 = (self.lo[k][nodes] - o[k]) * inv[k]
+                t2 = (self.hi[k][nodes] - o[k]) * inv[k]
+                t_in = np.fmax(t_in, np.minimum(t1, t2))
+                t_out = np.fmin(t_out, np.maximum(t1, t2))
+            return t_in <= np.minimum(t_out, t_max)
+
+    def _leaf_pairs(self, rays, nodes):
+        """(ray, primitive) pairs for every primitive of each (ray, leaf) pair."""
+        count = self.count[nodes]
+        r = np.repeat(rays, count)
+        offset = np.arange(len(r)) - np.repeat(np.cumsum(count) - count, count)
+        return r, self.perm[np.repeat(self.start[nodes], count) + offset]
+
+
+def _at(x, rays):
+    """A per-ray array at rays, or the scalar itself."""
+    return x if x.ndim == 0 else x[rays]
+
+
+def _build(lo, hi, leaf_size, bins):
+    """Top-down binned SAH, level by level; returns the flat node arrays and perm."""
+    center = (lo + hi) / 2
+    work = np.arange(len(lo))                 # primitives of this level's inner nodes, node by node
+    count = np.array([len(lo)])               # primitives per node of this level
+    levels, perm, placed, first = [], [], 0, 0
+    while len(count):
+        start = np.cumsum(count) - count
+        leaf = count <= leaf_size
+        in_leaf = np.repeat(leaf, count)
+        leaf_start = np.zeros(len(count), dtype=np.int64)
+        leaf_start[leaf] = placed + np.cumsum(count[leaf]) - count[leaf]
+        child = np.full(len(count), -1, dtype=np.int64)
+        child[~leaf] = first + len(count) + 2 * np.arange(np.count_nonzero(~leaf))
+        levels.append((np.minimum.reduceat(lo[work], start, axis=0), np.maximum.reduceat(hi[work], start, axis=0),
+                       child, leaf_start, np.where(leaf, count, 0)))
+        perm.append(work[in_leaf])
+        placed, first = placed + np.count_nonzero(in_leaf), first + len(count)
+        work, count = work[~in_leaf], count[~leaf]
+        if len(count):
+            work, count = _split(work, count, lo, hi, center, bins)
+    columns = [np.concatenate(c) for c in zip(*levels)]
+    return (*columns, np.concatenate(perm))
+
+
+def _split(work, count, lo, hi, center, bins):
+    """Partition each node's primitives by its best SAH cut; returns the children's work and counts."""
+    k = len(count)
+    seg = np.repeat(np.arange(k), count)
+    start = np.cumsum(count) - count
+    c = center[work]
+    c_lo, c_hi = np.minimum.reduceat(c, start, axis=0), np.maximum.reduceat(c, start, axis=0)
+    with np.errstate(divide="ignore"):
+        scale = np.where(c_hi > c_lo, bins / (c_hi - c_lo), 0.0)
+    b = np.minimum(((c - c_lo[seg]) * scale[seg]).astype(np.int64), bins - 1)    # (a, 3) bin per axis
+    axis, cut = _sah_cuts(b, seg, lo[work], hi[work], k, bins)
+    rank = np.arange(len(work)) - start[seg]
+    left = np.where(cut[seg] >= 0, b[np.arange(len(work)), axis[seg]] <= cut[seg], rank < count[seg] // 2)
+    order = np.argsort(2 * seg + ~left, kind="stable")
+    n_left = np.bincount(seg[left], minlength=k)
+    return work[order], np.stack([n_left, count - n_left], axis=1).ravel()
+
+
+def _sah_cuts(b, seg, p_lo, p_hi, k, bins):
+    """Per node, the axis and last left bin of least SAH cost; cut -1 when no bin boundary splits."""
+    key = (seg[:, None] * 3 + np.arange(3)) * bins + b                 # (a, 3): (node, axis, bin)
+    size = k * 3 * bins
+    n = np.bincount(key.ravel(), minlength=size).reshape(k, 3, bins)
+    b_lo, b_hi = np.full((3, size), np.inf), np.full((3, size), -np.inf)
+    for axis in range(3):
+        for j in range(3):
+            np.minimum.at(b_lo[j], key[:, axis], p_lo[:, j])
+            np.maximum.at(b_hi[j], key[:, axis], p_hi[:, j])
+    b_lo, b_hi = (x.reshape(3, k, 3, bins).transpose(1, 2, 3, 0) for x in (b_lo, b_hi))
+    n_l, a_l = np.cumsum(n, axis=2), _half_area(np.minimum.accumulate(b_lo, axis=2),
+                                                np.maximum.accumulate(b_hi, axis=2))
+    n_r = np.cumsum(n[:, :, ::-1], axis=2)[:, :, ::-1]
+    a_r = _half_area(np.minimum.accumulate(b_lo[:, :, ::-1], axis=2)[:, :, ::-1],
+                     np.maximum.accumulate(b_hi[:, :, ::-1], axis=2)[:, :, ::-1])
+    n_l, a_l, n_r, a_r = n_l[:, :, :-1], a_l[:, :, :-1], n_r[:, :, 1:], a_r[:, :, 1:]
+    with np.errstate(invalid="ignore"):
+        cost = np.where((n_l > 0) & (n_r > 0), n_l * a_l + n_r * a_r, np.inf).reshape(k, -1)
+    best = np.argmin(cost, axis=1)
+    ok = np.isfinite(cost[np.arange(k), best])
+    return best // (bins - 1), np.where(ok, best % (bins - 1), -1)
+
+
+def _half_area(lo, hi):
+    """Half the surface area of boxes (..., 3): ex ey + ey ez + ez ex (inf/NaN for empty boxes)."""
+    with np.errstate(invalid="ignore"):
+        e = hi - lo
+        return e[..., 0] * e[..., 1] + e[..., 1] * e[..., 2] + e[..., 2] * e[..., 0]
