@@ -12,6 +12,7 @@ import numpy as np
 
 from rtcli import camera as cameras
 from rtcli import yamlfile
+from rtcli.accel import Accelerator
 from rtcli.build_objects import ObjectBuilder, material_from
 from rtcli.errors import SceneError
 from rtcli.lights import PointLight
@@ -22,9 +23,15 @@ from rtcli.scene import Scene, Settings
 MAX_SIZE = 32768
 
 
-def load_scene(path: str) -> Scene:
-    """Read, check and build the scene at `path` (with its includes)."""
-    return scene_from_docs(yamlfile.load(path))
+def load_scene(path: str, bvh: bool = True) -> Scene:
+    """Read, check and build the scene at `path` (with its includes).
+
+    With `bvh` (the default) a scene of many bounded objects gets a BVH over them.
+    """
+    scene = scene_from_docs(yamlfile.load(path))
+    if bvh and Accelerator.wanted(scene):
+        scene.accel = Accelerator(scene)
+    return scene
 
 
 def scene_from_docs(docs: list) -> Scene:

@@ -50,9 +50,9 @@ def main(debug):
     """rtcli: a Whitted ray tracer for YAML scene files."""
 
 
-def _load(path):
+def _load(path, bvh=True):
     from rtcli.build import load_scene
-    return load_scene(path)
+    return load_scene(path, bvh)
 
 
 def _output(scene_path: str, out: str | None, suffix: str = ".png") -> str:
@@ -96,13 +96,14 @@ def _progress(enabled: bool, label: str):
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("--progress", is_flag=True, help="Show the progress bar even when stderr is not a terminal.")
 @click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")
+@click.option("--no-bvh", is_flag=True, help="Test every object against every ray (for comparisons).")
 def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
-           gamma, quiet, progress, stats):
+           gamma, quiet, progress, stats, no_bvh):
     """Render SCENE.yaml to a PNG."""
     from rtcli.render import render as render_image
     from rtcli.writer import write_png
     start = time.perf_counter()
-    scene = _load(scene_file)
+    scene = _load(scene_file, not no_bvh)
     out = _output(scene_file, output)
     if samples:
         scene.settings.samples = samples

@@ -14,6 +14,7 @@ import numpy as np
 
 from rtcli.rays import Rays
 from rtcli.scene import Scene
+from rtcli.shapes.sphere import sphere_uv
 from rtcli.vec import dot, normalize
 
 
@@ -80,20 +81,16 @@ def surface(scene: Scene, rays: Rays, hits: Hits) -> Surface:
     p = rays.at(hits.t)
     normal, geometric = np.empty((n, 3)), np.empty((n, 3))
     material, texture = np.empty(n, dtype=np.int64), np.ones((n, 3))
-    for k in np.unique(hits.obj):
-        rows = np.flatnonzero(hits.obj == k)
-        obj = scene.objects[k]
-        o_obj, d_obj = obj.to_object(rays.origin[rows], rays.direction[rows])
-        p_obj = o_obj + hits.t[rows, None] * d_obj
-        prim = hits.prim[rows]
-        ns = obj.shape.normal(p_obj, prim)
-        ng = obj.shape.geometric_normal(p_obj, prim) if hasattr(obj.shape, "geometric_normal") else ns
-        mat = obj.shape.material_of(prim, obj.material) if hasattr(obj.shape, "material_of") \
-            else np.full(len(rows), obj.material)
-        if obj.world_from_object is not None:
-            ns, ng = obj.world_from_object.normal(ns), obj.world_from_object.normal(ng)
-        normal[rows], geometric[rows], material[rows] = normalize(ns), normalize(ng), mat
-        _texture(scene, obj, p_obj, prim, mat, texture, rows)
+    batched = scene.accel.is_sphere[hits.obj] if scene.accel is not None else np.zeros(n, dtype=bool)
+    if batched.any():                                    # untransformed spheres, all at once
+        rows = np.flatnonzero(batched)
+        k = hits.obj[rows]
+        q = (p[rows] - scene.accel.center[k]) / scene.accel.radius[k, None]
+        normal[rows], geometric[rows], material[rows] = q, q, scene.accel.material[k]
+        _texture(scene, p[rows], lambda sel: sphere_uv(q[sel]), material[rows], texture, rows)
+    for k in np.unique(hits.obj[~batched]):
+        rows = np.flatnonzero((hits.obj == k) & ~batched)
+        _object_surface(scene, scene.objects[k], rays, hits, rows, normal, geometric, material, texture)
     entering = dot(rays.direction, geometric) < 0
     facing = np.where(entering, 1.0, -1.0)[:, None]
     n_face = normal * facing
@@ -101,12 +98,25 @@ def surface(scene: Scene, rays: Rays, hits: Hits) -> Surface:
     return Surface(p, n_face, geometric * facing, entering, material, texture)
 
 
-def _texture(scene, obj, p_obj, prim, mat, texture, rows) -> None:
-    """Fill texture[rows] for the textured materials among `mat`."""
+def _object_surface(scene, obj, rays, hits, rows, normal, geometric, material, texture) -> None:
+    """Fill the surface arrays at `rows`, all hits on one object."""
+    o_obj, d_obj = obj.to_object(rays.origin[rows], rays.direction[rows])
+    p_obj = o_obj + hits.t[rows, None] * d_obj
+    prim = hits.prim[rows]
+    ns = obj.shape.normal(p_obj, prim)
+    ng = obj.shape.geometric_normal(p_obj, prim) if hasattr(obj.shape, "geometric_normal") else ns
+    mat = obj.shape.material_of(prim, obj.material) if hasattr(obj.shape, "material_of") \
+        else np.full(len(rows), obj.material)
+    if obj.world_from_object is not None:
+        ns, ng = obj.world_from_object.normal(ns), obj.world_from_object.normal(ng)
+    normal[rows], geometric[rows], material[rows] = normalize(ns), normalize(ng), mat
+    _texture(scene, p_obj, lambda sel: obj.shape.uv(p_obj[sel], prim[sel]), mat, texture, rows)
+
+
+def _texture(scene, p_obj, uv_of, mat, texture, rows) -> None:
+    """Fill texture[rows] for the textured materials among `mat`; uv_of(selection) gives (u, v)."""
     table = scene.materials
     for m in table.textured:
         sel = mat == m
         if sel.any():
-            p_sel = p_obj[sel]
-            uv = obj.shape.uv(p_sel, prim[sel])
-            texture[rows[sel]] = table.materials[m].texture.color(p_sel, uv)
+            texture[rows[sel]] = table.materials[m].texture.color(p_obj[sel], uv_of(sel))

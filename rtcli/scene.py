@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -55,7 +56,7 @@ class Scene:
     eye: np.ndarray = field(default_factory=lambda: np.zeros(3))
     accel: object = None             # rtcli.accel.Accelerator, built by prepare()
 
-    @property
+    @functools.cached_property
     def size(self) -> float:
         """A length for the scene's scale: the diagonal of its bounded objects and the eye."""
         boxes = [b for b in (o.bounds() for o in self.objects) if b is not None]

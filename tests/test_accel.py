@@ -1,0 +1,71 @@
+"""The scene BVH returns exactly what testing every object returns."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rtcli.accel import Accelerator
+from rtcli.intersect import find_first_hit, occluded, surface
+from rtcli.rays import Rays
+from rtcli.render import Job, render
+
+
+def random_scene(yaml_scene, seed):
+    rng = np.random.default_rng(seed)
+    lines = ["camera: {eye: [0, 3, 14], look_at: [0, 0, 0]}", "lights: [{position: [4, 9, 6]}]",
+             "objects:", "  - {plane: {point: [0, -3, 0]}}"]
+    for k in range(40):
+        x, y, z = rng.uniform(-4, 4, 3)
+        kind = k % 4
+        if kind == 0:
+            lines.append(f"  - {{sphere: {{center: [{x}, {y}, {z}], radius: {rng.uniform(0.2, 1)}}}}}")
+        elif kind == 1:
+            lines.append(f"  - {{box: {{}}, transform: [{{scale: {rng.uniform(0.2, 0.7)}}}, "
+                         f"{{rotate: {{axis: [1, 1, 0], degrees: {rng.uniform(0, 90)}}}}}, {{translate: [{x}, {y}, {z}]}}]}}")
+        elif kind == 2:
+            lines.append(f"  - {{sphere: {{}}, transform: [{{scale: [0.3, 0.8, 0.5]}}, {{translate: [{x}, {y}, {z}]}}],"
+                         f" material: {{shadow: {str(bool(k % 8 == 2)).lower()}}}}}")
+        else:
+            lines.append(f"  - {{torus: {{major: 0.5, minor: 0.15}}, transform: [{{translate: [{x}, {y}, {z}]}}]}}")
+    return yaml_scene("\n".join(lines))
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_bvh_first_hit_equals_brute_force(yaml_scene, seed):
+    """Same t, object and primitive for every ray, with and without the BVH."""
+    scene = random_scene(yaml_scene, seed)
+    rng = np.random.default_rng(seed + 10)
+    rays = Rays(rng.normal(size=(3000, 3)) * 6, rng.normal(size=(3000, 3)))
+    brute = find_first_hit(scene, rays)
+    scene.accel = Accelerator(scene)
+    fast = find_first_hit(scene, rays)
+    assert np.isfinite(brute.t).sum() > 500
+    np.testing.assert_array_equal(fast.t, brute.t)
+    np.testing.assert_array_equal(fast.obj, brute.obj)
+    np.testing.assert_array_equal(fast.prim, brute.prim)
+
+
+def test_bvh_shadow_feelers_and_surfaces_equal_brute_force(yaml_scene):
+    """Shadow feelers (honouring shadow: false) and surface records agree with brute force."""
+    scene = random_scene(yaml_scene, 3)
+    rng = np.random.default_rng(5)
+    p, light = rng.normal(size=(3000, 3)) * 5, rng.normal(size=(3000, 3)) * 5
+    rays = Rays(rng.normal(size=(2000, 3)) * 6, rng.normal(size=(2000, 3)))
+    brute_blocked, hits = occluded(scene, p, light), find_first_hit(scene, rays)
+    seen = np.isfinite(hits.t)
+    brute_surface = surface(scene, rays[seen], hits[seen])
+    scene.accel = Accelerator(scene)
+    np.testing.assert_array_equal(occluded(scene, p, light), brute_blocked)
+    fast_surface = surface(scene, rays[seen], hits[seen])
+    np.testing.assert_allclose(fast_surface.n, brute_surface.n, atol=1e-12)
+    np.testing.assert_array_equal(fast_surface.material, brute_surface.material)
+
+
+def test_bvh_render_is_identical(yaml_scene):
+    """A whole render is byte-identical with and without the BVH."""
+    scene = random_scene(yaml_scene, 4)
+    brute, _ = render(scene, Job(64, 48))
+    scene.accel = Accelerator(scene)
+    fast, _ = render(scene, Job(64, 48))
+    np.testing.assert_array_equal(fast, brute)
