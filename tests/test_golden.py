@@ -23,13 +23,11 @@ from rtcli.writer import signature_colors, write_png
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = sorted(p for p in (ROOT / "scenes").glob("*.yaml"))
 GOLDEN = ROOT / "golden_images"
-SLOW = {"bunny", "teapot", "spot", "torus100k", "spheres1k"}     # heavy renders: `make test-all`
 FAILURES = Path(tempfile.gettempdir()) / "rtcli-golden-failures"
 
 
 def _param(path: Path):
-    marks = [pytest.mark.slow] if path.stem in SLOW else []
-    return pytest.param(path, id=path.stem, marks=marks)
+    return pytest.param(path, id=path.stem)
 
 
 def _update(request) -> bool:
