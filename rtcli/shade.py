@@ -18,22 +18,27 @@ from rtcli.stats import Stats
 from rtcli.vec import dot, normalize
 
 
-def specular(N, L, V, n, model: str) -> np.ndarray:
-    """spec for unit N, L, V and exponents n."""
+def specular(N, L, V, NL, NV, n, model: str) -> np.ndarray:
+    """spec for unit N, L, V (NL = N.L, NV = N.V) and exponents n.
+
+    phong: R.V with R = 2(N.L)N - L, so R.V = 2(N.L)(N.V) - L.V; blinn: N.H, H = norm(L + V).
+    """
     if model == "blinn":
-        cos = dot(N, normalize(L + V))                   # N.H
+        H = L + V
+        cos = dot(N, H) / np.sqrt(dot(H, H))
     else:
-        NL = dot(N, L)
-        cos = dot(2 * NL[:, None] * N - L, V)            # R.V
+        cos = 2 * NL * NV - dot(L, V)
     return np.maximum(cos, 0) ** n
 
 
 def local(scene: Scene, rays: Rays, s: Surface, stats: Stats) -> np.ndarray:
     """Emission, ambient and direct light at each surface point."""
     m, table = s.material, scene.materials
-    kd_T = table.kd[m] * s.texture
+    kd_T, ks, n = table.kd[m] * s.texture, table.ks[m], table.n[m]
     color = table.emission[m] + table.ka[m] * scene.ambient * s.texture
     V = -normalize(rays.direction)
+    NV = dot(s.n, V)
+    shiny = ks.max(axis=1) > 0                           # spec is only worked out where ks > 0
     start = s.p + scene.offset * s.ng                    # feelers leave from the lit side
     for light in scene.lights:
         points = light.sample_points(s.p)
@@ -42,11 +47,14 @@ def local(scene: Scene, rays: Rays, s: Surface, stats: Stats) -> np.ndarray:
             r = np.sqrt(dot(to_light, to_light))
             L = to_light / r[:, None]
             NL = dot(s.n, L)
-            lit = np.flatnonzero(NL > 0)
+            lit = np.flatnonzero(NL > 0)                 # N.L <= 0: no contribution (004, case 2)
             stats.shadow += len(lit)
             lit = lit[~occluded(scene, start[lit], lp[lit])]
-            spec = specular(s.n[lit], L[lit], V[lit], table.n[m[lit]], scene.settings.specular)
             weight = light.attenuate(r[lit]) * light.spot_factor(L[lit]) / len(points)
-            color[lit] += (weight[:, None] * light.color) * (
-                kd_T[lit] * NL[lit, None] + table.ks[m[lit]] * spec[:, None])
+            color[lit] += (weight * NL[lit])[:, None] * light.color * kd_T[lit]
+            hl = lit[shiny[lit]]
+            if len(hl):
+                spec = specular(s.n[hl], L[hl], V[hl], NL[hl], NV[hl], n[hl], scene.settings.specular)
+                w = weight[shiny[lit]] * spec
+                color[hl] += w[:, None] * light.color * ks[hl]
     return color
