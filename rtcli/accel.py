@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rtcli import kernels
 from rtcli.bvh import BVH
 from rtcli.shapes.sphere import Sphere, nearest_root, sphere_roots
 
@@ -33,6 +34,11 @@ class Accelerator:
         self.radius = np.array([o.shape.radius if s else 1.0 for o, s in zip(objects, self.is_sphere)])
         self.material = np.array([o.material for o in objects], dtype=np.int64)
         self.shadow = scene.materials.shadow[self.material]
+        self.all_spheres = bool(is_sphere.all())       # then the compiled traversal can do it all
+        k = self.members
+        self.kernel_args = (self.center[k], (self.radius[k] ** 2)[:, None], np.ones((len(k), 1)))
+        self.kernel_shadow = (self.center[k], (self.radius[k] ** 2)[:, None],
+                              self.shadow[k].astype(float)[:, None])
 
     @staticmethod
     def wanted(scene) -> bool:
@@ -63,6 +69,11 @@ class Accelerator:
             t, prim = object_hit(scene.objects[k], o, d, t_min, hits.t)
             closer = t < hits.t
             hits.t[closer], hits.obj[closer], hits.prim[closer] = t[closer], k, prim[closer]
+        if kernels.ENABLED and self.all_spheres:
+            t, member = kernels.traverse(self.bvh, o, d, t_min, hits.t, 1, *self.kernel_args)
+            won = member >= 0
+            hits.t[won], hits.obj[won], hits.prim[won] = t[won], self.members[member[won]], 0
+            return hits
         best, sub = hits.t.copy(), np.zeros(n, dtype=np.int64)
 
         def pairs(r, m, t_max):
@@ -89,6 +100,10 @@ class Accelerator:
                 t, _ = object_hit(scene.objects[k], points[todo], d[todo], 0.0, 1.0)
                 blocked[todo] = np.isfinite(t)
         todo = np.flatnonzero(~blocked)
+        if kernels.ENABLED and self.all_spheres:
+            blocked[todo] = kernels.traverse(self.bvh, points[todo], d[todo], 0.0, 1.0, 1,
+                                             *self.kernel_shadow, any_hit=True)
+            return blocked
         pairs = lambda r, m, t_max: self._pair_test(scene, points[todo], d[todo], 0.0, r, m, t_max, True)[0]
         blocked[todo] = self.bvh.any_hit(points[todo], d[todo], 0.0, 1.0, pairs)
         return blocked

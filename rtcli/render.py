@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rtcli import kernels
 from rtcli.intersect import find_first_hit
 from rtcli.jitter import uniform
 from rtcli.scene import Scene
@@ -123,6 +124,7 @@ def _map_tiles(scene: Scene, job: Job, tiles: list, workers: int):
         for rows, cols in tiles:
             yield _run_tile(scene, job, rows, cols)
         return
+    kernels.warm_up()                      # loaded once here, not once per worker
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
                              initargs=(scene,)) as pool:
