@@ -8,30 +8,25 @@ feelers at their first blocker. Each (ray, primitive) test does the same
 floating-point operations in the same order as the numpy code (Triangle's
 Cramer solve, the sphere's stable quadratic), so both paths give the same t.
 
-Without numba the module still imports (the decorator becomes a no-op) and
-`ENABLED` is False: callers keep to numpy.
+numba is imported, and the kernels compiled (or loaded from numba's cache), on
+first use only: importing numba costs ~0.15 s that scenes without meshes or
+sphere sets should not pay. Without numba, `ENABLED` is False and callers keep
+to numpy; the functions still run as plain Python (the tests use that).
 """
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import os
 
 import numpy as np
 
-try:
-    from numba import njit
-    ENABLED = os.environ.get("RTCLI_NUMBA", "1") != "0"
-except ImportError:                                    # numba is optional
-    ENABLED = False
-
-    def njit(*args, **kwargs):
-        return (lambda f: f) if not args or not callable(args[0]) else args[0]
-
+ENABLED = os.environ.get("RTCLI_NUMBA", "1") != "0" and importlib.util.find_spec("numba") is not None
 STACK = 64                                             # deeper than any binned-SAH tree we build
+_compiled = False
 
 
-@njit(cache=True)
 def _slab(o, inv, lo, hi, node, t_near, t_far):
     """The ray meets node's box within [t_near, t_far] (bvh.BVH._slab, per ray)."""
     for k in range(3):
@@ -44,7 +39,6 @@ def _slab(o, inv, lo, hi, node, t_near, t_far):
     return t_near <= t_far
 
 
-@njit(cache=True)
 def _triangle(o, d, a, e1, e2):
     """t of o + t d in the triangle a + alpha e1 + beta e2, or inf (planar._solve's operations)."""
     p0, p1, p2 = d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]
@@ -62,7 +56,6 @@ def _triangle(o, d, a, e1, e2):
     return np.inf
 
 
-@njit(cache=True)
 def _sphere(o, d, c, r2, t_min, t_max):
     """The first root in (t_min, t_max) of the sphere test (sphere.sphere_roots's operations)."""
     S0, S1, S2 = o[0] - c[0], o[1] - c[1], o[2] - c[2]
@@ -82,7 +75,6 @@ def _sphere(o, d, c, r2, t_min, t_max):
     return t if t_min < t < t_max else np.inf
 
 
-@njit(cache=True)
 def _traverse(o, d, t_min, t_max, lo, hi, child, start, count, perm, kind, prim_a, prim_b, prim_c,
               any_hit):
     """Nearest (or any) primitive hit per ray. kind 0: triangles (a, e1, e2); 1: spheres (c, r2, casts)."""
@@ -119,8 +111,22 @@ def _traverse(o, d, t_min, t_max, lo, hi, child, start, count, perm, kind, prim_
     return best, won
 
 
+def _compile() -> None:
+    """Swap the plain functions for numba-compiled ones (cached on disk by numba)."""
+    global _slab, _triangle, _sphere, _traverse, _compiled
+    _compiled = True
+    try:
+        from numba import njit
+    except ImportError:                                # stay plain Python
+        return
+    _slab, _triangle, _sphere = (njit(cache=True)(f) for f in (_slab, _triangle, _sphere))
+    _traverse = njit(cache=True)(_traverse)
+
+
 def traverse(bvh, o, d, t_min, t_max, kind, a, b, c, any_hit=False):
     """(t, prim) like BVH.intersect (prim -1 on a miss), or the blocked mask when any_hit."""
+    if ENABLED and not _compiled:
+        _compile()
     n = len(o)
     t_min = np.broadcast_to(np.asarray(t_min, dtype=float), (n,)).copy()
     t_max = np.broadcast_to(np.asarray(t_max, dtype=float), (n,)).copy()
