@@ -136,15 +136,8 @@ class Params:
         return self.numbers_value(key, x, count, what)
 
     def numbers_value(self, key, x, count, what="a vector", label=None) -> np.ndarray:
-        label = label or self.key_path(key)
         where = self.node.value_where.get(key, self.node.where)
-        if not isinstance(x, list) or len(x) != count:
-            raise SceneError(where, label, f"must be {what} of {count} numbers, got {describe(x)}")
-        for k, v in enumerate(x):
-            item_where = x.item_where[k] if isinstance(x, SeqNode) else where
-            if not _is_number(v) or not math.isfinite(v):
-                raise SceneError(item_where, f"{label}[{k}]", f"must be a finite number, got {describe(v)}")
-        return np.array(x, dtype=float)
+        return finite_numbers(x, where, label or self.key_path(key), count, f"{what} of {count} numbers")
 
     def vector(self, key, default=REQUIRED) -> np.ndarray:
         return self.numbers(key, 3, default, "a vector [x, y, z]")
@@ -165,13 +158,7 @@ class Params:
 
     def _item_numbers(self, seq, k, v, count, what, label) -> np.ndarray:
         where = seq.item_where[k] if isinstance(seq, SeqNode) else self.node.where
-        if not isinstance(v, list) or len(v) != count:
-            raise SceneError(where, label, f"must be {what}, got {describe(v)}")
-        for m, w in enumerate(v):
-            w_where = v.item_where[m] if isinstance(v, SeqNode) else where
-            if not _is_number(w) or not math.isfinite(w):
-                raise SceneError(w_where, f"{label}[{m}]", f"must be a finite number, got {describe(w)}")
-        return np.array(v, dtype=float)
+        return finite_numbers(v, where, label, count, what)
 
     def color(self, key, default=REQUIRED) -> np.ndarray:
         """[r, g, b] of non-negative floats, or "#rrggbb"."""
@@ -224,6 +211,17 @@ class Params:
         if not isinstance(x, SeqNode):
             raise self.error(key, f"must be a list, got {describe(x)}")
         return [(v, x.item_where[k], f"{self.key_path(key)}[{k}]") for k, v in enumerate(x)]
+
+
+def finite_numbers(x, where: Where, label: str, count: int, what: str) -> np.ndarray:
+    """x as an array if it is a list of exactly `count` finite numbers, else a located error."""
+    if not isinstance(x, list) or len(x) != count:
+        raise SceneError(where, label, f"must be {what}, got {describe(x)}")
+    for k, v in enumerate(x):
+        item_where = x.item_where[k] if isinstance(x, SeqNode) else where
+        if not _is_number(v) or not math.isfinite(v):
+            raise SceneError(item_where, f"{label}[{k}]", f"must be a finite number, got {describe(v)}")
+    return np.array(x, dtype=float)
 
 
 def as_params(item, where: Where, path: str, what: str = "a mapping of keys") -> Params:
