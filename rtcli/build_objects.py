@@ -144,7 +144,7 @@ def _matrix(p: Params) -> np.ndarray:
         raise p.error("matrix", f"must be 3 or 4 rows of 4 numbers, got {describe(p.node['matrix'])}")
     m = np.eye(4)
     for k, (row, where, path) in enumerate(rows):
-        m[k] = p._item_numbers(p.node["matrix"], k, row, 4, "a row of 4 numbers", path)
+        m[k] = p.item_numbers(p.node["matrix"], k, row, 4, "a row of 4 numbers", path)
     if not np.array_equal(m[3], [0, 0, 0, 1]):
         raise p.error("matrix", "the 4th row must be [0, 0, 0, 1] (affine transforms only)")
     return m

@@ -153,10 +153,11 @@ class Params:
             raise SceneError(where, self.key_path(key), f"must be a list of {need} vectors, got {describe(x)}")
         rows = []
         for k, v in enumerate(x):
-            rows.append(self._item_numbers(x, k, v, 3, "a vector [x, y, z]", f"{self.key_path(key)}[{k}]"))
+            rows.append(self.item_numbers(x, k, v, 3, "a vector [x, y, z]", f"{self.key_path(key)}[{k}]"))
         return np.array(rows, dtype=float).reshape(-1, 3)
 
-    def _item_numbers(self, seq, k, v, count, what, label) -> np.ndarray:
+    def item_numbers(self, seq, k, v, count, what, label) -> np.ndarray:
+        """Item k (value v) of the list seq as `count` finite numbers."""
         where = seq.item_where[k] if isinstance(seq, SeqNode) else self.node.where
         return finite_numbers(v, where, label, count, what)
 
