@@ -88,7 +88,7 @@ def surface(scene: Scene, rays: Rays, hits: Hits) -> Surface:
         q = (p[rows] - scene.accel.center[k]) / scene.accel.radius[k, None]
         normal[rows], geometric[rows], material[rows] = q, q, scene.accel.material[k]
         _texture(scene, p[rows], lambda sel: sphere_uv(q[sel]), material[rows], texture, rows)
-    for k in np.unique(hits.obj[~batched]):
+    for k in np.flatnonzero(np.bincount(hits.obj[~batched], minlength=len(scene.objects))):
         rows = np.flatnonzero((hits.obj == k) & ~batched)
         _object_surface(scene, scene.objects[k], rays, hits, rows, normal, geometric, material, texture)
     entering = dot(rays.direction, geometric) < 0
@@ -107,9 +107,12 @@ def _object_surface(scene, obj, rays, hits, rows, normal, geometric, material, t
     ng = obj.shape.geometric_normal(p_obj, prim) if hasattr(obj.shape, "geometric_normal") else ns
     mat = obj.shape.material_of(prim, obj.material) if hasattr(obj.shape, "material_of") \
         else np.full(len(rows), obj.material)
+    same = ng is ns
     if obj.world_from_object is not None:
-        ns, ng = obj.world_from_object.normal(ns), obj.world_from_object.normal(ng)
-    normal[rows], geometric[rows], material[rows] = normalize(ns), normalize(ng), mat
+        ns = obj.world_from_object.normal(ns)
+        ng = ns if same else obj.world_from_object.normal(ng)
+    normal[rows] = normalize(ns)
+    geometric[rows], material[rows] = normal[rows] if same else normalize(ng), mat
     _texture(scene, p_obj, lambda sel: obj.shape.uv(p_obj[sel], prim[sel]), mat, texture, rows)
 
 

@@ -39,6 +39,9 @@ class MaterialTable:
         self.n, self.emission = stack("shininess"), stack("emission")
         self.kr, self.kt, self.ior = stack("reflection"), stack("transmission"), stack("ior")
         self.shadow = np.array([m.shadow for m in materials], dtype=bool)
+        self.shiny = self.ks.max(axis=1) > 0            # which materials need the specular term,
+        self.mirror = self.kr.max(axis=1) > 0           # a mirror ray,
+        self.clear = self.kt.max(axis=1) > 0            # a refracted ray
         self.textured = [k for k, m in enumerate(materials) if m.texture is not None]
 
     def __len__(self) -> int:

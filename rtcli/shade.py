@@ -38,7 +38,7 @@ def local(scene: Scene, rays: Rays, s: Surface, stats: Stats) -> np.ndarray:
     color = table.emission[m] + table.ka[m] * scene.ambient * s.texture
     V = -normalize(rays.direction)
     NV = dot(s.n, V)
-    shiny = ks.max(axis=1) > 0                           # spec is only worked out where ks > 0
+    shiny = table.shiny[m]                               # spec is only worked out where ks > 0
     start = s.p + scene.offset * s.ng                    # feelers leave from the lit side
     for light in scene.lights:
         points = light.sample_points(s.p)

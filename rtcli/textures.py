@@ -20,8 +20,8 @@ class Checker:
     size: float = 1.0
 
     def color(self, p_object: np.ndarray, uv: np.ndarray) -> np.ndarray:
-        cells = np.floor(p_object / self.size + 1e-6).astype(np.int64).sum(axis=1)
-        return np.where((cells % 2 == 0)[:, None], self.color1, self.color2)
+        cells = np.floor(p_object * (1 / self.size) + 1e-6).sum(axis=1)      # an integer, as a float
+        return np.where((np.fmod(cells, 2) == 0)[:, None], self.color1, self.color2)
 
 
 @dataclass(frozen=True)

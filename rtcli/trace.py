@@ -37,12 +37,12 @@ def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats) -> np.ndarray:
     table, D = scene.materials, normalize(rays.direction)
     kr, kt = table.kr[s.material], table.kt[s.material]
     eps = scene.offset * s.ng                            # step off the surface, to the ray's side
-    mirror = np.flatnonzero(kr.max(axis=1) > 0)
+    mirror = np.flatnonzero(table.mirror[s.material])
     if len(mirror):
         stats.reflected += len(mirror)
         ms = reflect(D[mirror], s.n[mirror])             # ms = d - 2 (d.n) n
         color[mirror] += kr[mirror] * trace(scene, Rays(s.p[mirror] + eps[mirror], ms), depth + 1, stats)
-    clear = np.flatnonzero(kt.max(axis=1) > 0)
+    clear = np.flatnonzero(table.clear[s.material])
     if len(clear):
         ior = table.ior[s.material[clear]]
         eta = np.where(s.entering[clear], 1.0 / ior, ior)  # 1 -> ior entering, ior -> 1 leaving

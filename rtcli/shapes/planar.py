@@ -15,7 +15,7 @@ def _plane_t(o, d, point, n, t_min, t_max):
     """lambda* = (p1 - a).n / (d.n) (notes 000 11.3.1); inf when parallel or out of range."""
     denom = dot(d, n)
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = dot(point - o, n) / denom
+        t = (dot(point, n) - dot(o, n)) / denom
     return np.where((denom != 0) & (t > t_min) & (t < t_max), t, np.inf)
 
 
