@@ -86,9 +86,7 @@ class BVH:
         if self.m == 0 or len(o) == 0:
             return
         n, t_min = len(o), np.asarray(t_min, dtype=float)
-        o = np.ascontiguousarray(np.asarray(o, dtype=float).T)   # per axis, so the slab test runs on 1-D columns
-        with np.errstate(divide="ignore"):
-            inv = 1.0 / np.ascontiguousarray(np.asarray(d, dtype=float).T)   # +-inf for zero components
+        o, inv = columns(o, d)              # per axis, so the slab test runs on 1-D columns
         for s in range(0, n, CHUNK):
             rays = np.arange(s, min(s + CHUNK, n))
             rays = rays[self._slab(o[:, rays], inv[:, rays], 0, _at(t_min, rays), far[rays])]
@@ -108,21 +106,8 @@ class BVH:
         return np.concatenate([rays[hit_l], rays[hit_r]]), np.concatenate([left[hit_l], left[hit_r] + 1])
 
     def _slab(self, o, inv, nodes, t_min, t_max):
-        """Kay-Kajiya slab test of (ray, node) pairs against [t_min, t_max].
-
-        A zero direction component gives +-inf, and NaN (0 x inf) when the
-        origin lies on that slab's plane: the ray then runs inside the closed
-        slab, so NaN must not constrain; np.minimum/maximum keep the NaN and
-        np.fmax/fmin then skip it. A NaN t_max (a blocked ray) fails.
-        """
-        t_in, t_out = t_min, np.inf
-        with np.errstate(invalid="ignore"):
-            for k in range(3):
-                t1 = (self.lo[k][nodes] - o[k]) * inv[k]
-                t2 = (self.hi[k][nodes] - o[k]) * inv[k]
-                t_in = np.fmax(t_in, np.minimum(t1, t2))
-                t_out = np.fmin(t_out, np.maximum(t1, t2))
-            return t_in <= np.minimum(t_out, t_max)
+        """Slab test of (ray, node) pairs against [t_min, t_max]; see slab()."""
+        return slab(o, inv, [lo[nodes] for lo in self.lo], [hi[nodes] for hi in self.hi], t_min, t_max)
 
     def _leaf_pairs(self, rays, nodes):
         """(ray, primitive) pairs for every primitive of each (ray, leaf) pair."""
@@ -130,6 +115,31 @@ class BVH:
         r = np.repeat(rays, count)
         offset = np.arange(len(r)) - np.repeat(np.cumsum(count) - count, count)
         return r, self.perm[np.repeat(self.start[nodes], count) + offset]
+
+
+def slab(o, inv, lo, hi, t_min, t_max):
+    """Kay-Kajiya slab test: does each ray meet its box within [t_min, t_max]?
+
+    o and inv (3, n): ray origins and 1 / directions by axis; lo, hi: per axis,
+    arrays (n,) or numbers. A zero direction component gives +-inf, and NaN
+    (0 x inf) when the origin lies on that slab's plane: the ray then runs inside
+    the closed slab, so NaN must not constrain; np.minimum/maximum keep the NaN
+    and np.fmax/fmin then skip it. A NaN t_max (a blocked ray) fails.
+    """
+    t_in, t_out = t_min, np.inf
+    with np.errstate(invalid="ignore"):
+        for k in range(3):
+            t1 = (lo[k] - o[k]) * inv[k]
+            t2 = (hi[k] - o[k]) * inv[k]
+            t_in = np.fmax(t_in, np.minimum(t1, t2))
+            t_out = np.fmin(t_out, np.maximum(t1, t2))
+        return t_in <= np.minimum(t_out, t_max)
+
+
+def columns(o, d):
+    """(o, 1/d) as (3, n) arrays, the layout slab() wants."""
+    with np.errstate(divide="ignore"):
+        return np.ascontiguousarray(np.asarray(o, float).T), 1.0 / np.ascontiguousarray(np.asarray(d, float).T)
 
 
 def _at(x, rays):

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rtcli.bvh import columns, slab
 from rtcli.rays import Rays
 from rtcli.scene import Scene
 from rtcli.shapes.sphere import sphere_uv
@@ -45,33 +46,49 @@ def object_hit(obj, o, d, t_min, t_max):
     return t, (np.zeros(len(o), dtype=np.int64) if prim is None else prim)
 
 
+def _candidates(scene: Scene, k: int, o_cols, inv_cols, rows, t_max):
+    """The rows whose ray meets object k's world box before t_max (all rows if unbounded)."""
+    box = scene.boxes[k]
+    if box is None or len(rows) == 0:
+        return rows
+    return rows[slab(o_cols[:, rows], inv_cols[:, rows], box[0], box[1], 0.0, t_max)]
+
+
 def find_first_hit(scene: Scene, rays: Rays, t_min: float = 0.0) -> Hits:
-    """Nearest hit over all objects (an acceleration structure, when built, prunes them)."""
+    """Nearest hit over all objects: through the BVH when the scene has one, else
+    object by object, each tested only on the rays that meet its bounding box."""
     if scene.accel is not None:
         return scene.accel.first_hit(scene, rays, t_min)
     n = len(rays)
     best = Hits(np.full(n, np.inf), np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=np.int64))
+    o_cols, inv_cols = columns(rays.origin, rays.direction)
+    every = np.arange(n)
     for k, obj in enumerate(scene.objects):
-        t, prim = object_hit(obj, rays.origin, rays.direction, t_min, best.t)
-        closer = t < best.t
-        best.t[closer], best.obj[closer], best.prim[closer] = t[closer], k, prim[closer]
+        rows = _candidates(scene, k, o_cols, inv_cols, every, best.t)
+        if len(rows):
+            t, prim = object_hit(obj, rays.origin[rows], rays.direction[rows], t_min, best.t[rows])
+            closer = t < best.t[rows]
+            won = rows[closer]
+            best.t[won], best.obj[won], best.prim[won] = t[closer], k, prim[closer]
     return best
 
 
 def occluded(scene: Scene, points: np.ndarray, lights: np.ndarray) -> np.ndarray:
-    """Shadow feelers p + t (l - p): True where an object that casts shadows is hit for 0 < t < 1."""
+    """Shadow feelers p + t (l - p): True where an object that casts shadows is hit for 0 < t < 1.
+
+    A feeler stops at its first blocker: later objects test only the rays still open.
+    """
     if scene.accel is not None:
         return scene.accel.occluded(scene, points, lights)
     d = lights - points
+    o_cols, inv_cols = columns(points, d)
     blocked = np.zeros(len(points), dtype=bool)
-    for obj in scene.objects:
-        if not scene.materials.shadow[obj.material]:
-            continue
-        todo = np.flatnonzero(~blocked)
-        if len(todo) == 0:
-            break
-        t, _ = object_hit(obj, points[todo], d[todo], 0.0, 1.0)
-        blocked[todo] = np.isfinite(t)
+    for k, obj in enumerate(scene.objects):
+        if scene.materials.shadow[obj.material]:
+            todo = _candidates(scene, k, o_cols, inv_cols, np.flatnonzero(~blocked), 1.0)
+            if len(todo):
+                t, _ = object_hit(obj, points[todo], d[todo], 0.0, 1.0)
+                blocked[todo] = np.isfinite(t)
     return blocked
 
 

@@ -57,9 +57,14 @@ class Scene:
     accel: object = None             # rtcli.accel.Accelerator, built by prepare()
 
     @functools.cached_property
+    def boxes(self) -> list:
+        """Each object's world-space box (lo, hi), or None when it is unbounded."""
+        return [o.bounds() for o in self.objects]
+
+    @functools.cached_property
     def size(self) -> float:
         """A length for the scene's scale: the diagonal of its bounded objects and the eye."""
-        boxes = [b for b in (o.bounds() for o in self.objects) if b is not None]
+        boxes = [b for b in self.boxes if b is not None]
         lo = np.min([self.eye] + [b[0] for b in boxes], axis=0)
         hi = np.max([self.eye] + [b[1] for b in boxes], axis=0)
         return max(float(np.linalg.norm(hi - lo)), 1e-3)
