@@ -90,7 +90,7 @@ def _progress(enabled: bool, label: str):
 @click.option("--samples", type=click.IntRange(1, 16), help="N x N samples per pixel.")
 @click.option("--max-depth", type=click.IntRange(1, 64), help="Rays per path, the primary included.")
 @click.option("--workers", type=click.IntRange(1, 256), help="Worker processes (default: all cores).")
-@click.option("--tile", type=click.IntRange(1, 4096), default=64, show_default=True,
+@click.option("--tile", type=click.IntRange(1, 4096), default=128, show_default=True,
               help="Tile edge in pixels (memory per worker).")
 @click.option("--gamma", is_flag=True, help="sRGB-encode the output (default: linear).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")

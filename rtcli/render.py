@@ -25,7 +25,7 @@ from rtcli.stats import Stats
 from rtcli.trace import trace
 from rtcli.writer import to_8bit
 
-TILE = 64                                  # tile edge in pixels (rays per tile: TILE^2 x samples^2)
+TILE = 128                                 # tile edge in pixels (rays per tile: TILE^2 x samples^2)
 
 
 @dataclass(frozen=True)
