@@ -42,6 +42,8 @@ class Params:
         if not isinstance(node, MapNode):
             raise TypeError("Params needs a MapNode")
         self.node, self.path, self.read = node, path, set()
+        for key, where, first in getattr(node, "duplicates", []):
+            raise SceneError(where, self.key_path(key), f"duplicate key (first given at line {first.line})")
 
     # --- locations and errors ---
     @property

@@ -26,6 +26,7 @@ class MapNode(dict):
     key_where: dict
     value_where: dict
     folder: str                             # folder of the file it came from
+    duplicates: list                        # (key, where, where_first) of keys given twice; Params reports them
 
 
 class SeqNode(list):
@@ -51,17 +52,16 @@ def _where(loader: _Loader, mark) -> Where:
 
 
 def _construct_map(loader: _Loader, node: yaml.MappingNode) -> MapNode:
-    seen = {}
+    first, duplicates = {}, []
     for key_node, _ in node.value:
-        if key_node.tag == "tag:yaml.org,2002:merge":
-            continue
-        if isinstance(key_node, yaml.ScalarNode):
-            if key_node.value in seen:
-                raise SceneError(_where(loader, key_node.start_mark), str(key_node.value),
-                                 "duplicate key")
-            seen[key_node.value] = True
+        if isinstance(key_node, yaml.ScalarNode) and key_node.tag != "tag:yaml.org,2002:merge":
+            where = _where(loader, key_node.start_mark)
+            if key_node.value in first:
+                duplicates.append((key_node.value, where, first[key_node.value]))
+            first.setdefault(key_node.value, where)
     loader.flatten_mapping(node)
     result = MapNode()
+    result.duplicates = duplicates
     result.where = _where(loader, node.start_mark)
     result.key_where, result.value_where = {}, {}
     result.folder = loader.folder
@@ -96,7 +96,10 @@ def parse(text: str, display: str, folder: str = ".") -> MapNode:
     except yaml.MarkedYAMLError as e:
         mark = e.problem_mark or e.context_mark
         where = Where(display, mark.line + 1, mark.column + 1) if mark else display
-        raise SceneError(where, "", f"invalid YAML: {e.problem or e.context}") from None
+        problem = e.problem or e.context
+        if mark and _char_at(text, mark.line, mark.column) == "\t":
+            problem = "tab characters cannot indent YAML (use spaces)"
+        raise SceneError(where, "", f"invalid YAML: {problem}") from None
     except yaml.YAMLError as e:
         raise SceneError(display, "", f"invalid YAML: {e}") from None
     except RecursionError:
@@ -106,10 +109,15 @@ def parse(text: str, display: str, folder: str = ".") -> MapNode:
     if tree is None:
         tree = MapNode()
         tree.where, tree.key_where, tree.value_where = Where(display, 1, 1), {}, {}
-        tree.folder = folder
+        tree.folder, tree.duplicates = folder, []
     if not isinstance(tree, MapNode):
         raise SceneError(Where(display, 1, 1), "", "a scene must be a mapping of keys")
     return tree
+
+
+def _char_at(text: str, line: int, column: int) -> str:
+    lines = text.splitlines()
+    return lines[line][column] if line < len(lines) and column < len(lines[line]) else ""
 
 
 def read_text(path: str, where=None, key: str = "") -> str:
