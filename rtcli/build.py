@@ -105,10 +105,12 @@ def camera_from(c: Params):
         c.check_unused()
         return functools.partial(cameras.from_screen, eye, ll, h, v), eye
     look_at, up = c.vector("look_at"), c.vector("up", (0.0, 1.0, 0.0))
-    try:
-        cameras.eye_basis(eye, look_at, up)
-    except ValueError as e:
-        raise c.error("up" if "up" in str(e) else "look_at", str(e)) from None
+    if not np.any(look_at - eye):
+        raise c.error("look_at", "must differ from eye")
+    if np.linalg.norm(np.cross(look_at - eye, up)) <= 1e-9 * np.linalg.norm(look_at - eye) * np.linalg.norm(up):
+        if c.has("up"):
+            raise c.error("up", "must not be parallel to the view direction (look_at - eye)")
+        raise c.error(None, "the default up [0, 1, 0] is parallel to the view direction; give camera.up")
     if c.has("window"):
         focal = c.number("focal", 1.0, positive=True)
         w = c.sub("window")

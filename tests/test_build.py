@@ -160,7 +160,11 @@ GEOMETRY = {
                              "polygon vertices are not coplanar"),
     #          "camera: {eye: [0, 0, 5], look_at: [0, 0, 0], up: [0, 0, 1]}": up's '[' at 50
     "up_parallel": ("camera: {eye: [0, 0, 5], look_at: [0, 0, 0], up: [0, 0, 1]}\n",
-                    "scene.yaml:1:50: camera.up: up must not be parallel to the view direction"),
+                    "scene.yaml:1:50: camera.up: must not be parallel to the view direction (look_at - eye)"),
+    #          "camera: {eye: [0, 5, 0], ...": the camera mapping at 9, up left to its default
+    "default_up_parallel": ("camera: {eye: [0, 5, 0], look_at: [0, 0, 0]}\n",
+                            "scene.yaml:1:9: camera: the default up [0, 1, 0] is parallel to the view "
+                            "direction; give camera.up"),
     #          "      - scale: 0": value at 16
     "scale_0": (obj("sphere: {}\n    transform:\n      - scale: 0"),
                 "scene.yaml:5:16: objects[0].transform[0].scale: singular transform (determinant 0)"),
