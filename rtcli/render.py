@@ -119,12 +119,20 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     return image, stats
 
 
+def _uses_kernels(scene: Scene) -> bool:
+    """Whether tracing this scene calls the compiled traversal (meshes, sets of spheres)."""
+    from rtcli.shapes.mesh import Mesh
+    return (any(isinstance(o.shape, Mesh) for o in scene.objects)
+            or (scene.accel is not None and scene.accel.all_spheres))
+
+
 def _map_tiles(scene: Scene, job: Job, tiles: list, workers: int):
     if workers <= 1 or len(tiles) == 1:
         for rows, cols in tiles:
             yield _run_tile(scene, job, rows, cols)
         return
-    kernels.warm_up()                      # loaded once here, not once per worker
+    if _uses_kernels(scene):
+        kernels.warm_up()                  # loaded once here, not once per worker
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
                              initargs=(scene,)) as pool:
