@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,8 +82,11 @@ def _tiles(job: Job):
 
 
 def _run_tile(scene: Scene, job: Job, rows: np.ndarray, cols: np.ndarray):
+    """A tile's 8-bit pixels (or ids), small enough to pile up while the parent catches up."""
     jj, ii = np.meshgrid(rows, cols, indexing="ij")
     values, stats = render_tile(scene, job, ii.ravel(), jj.ravel())
+    if not job.signature:
+        values = to_8bit(values, job.gamma)
     return rows, cols, values.reshape(len(rows), len(cols), *values.shape[1:]), stats
 
 
@@ -102,15 +105,14 @@ def _worker_tile(job: Job, rows, cols):
 def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.ndarray, Stats]:
     """The 8-bit image (H, W, 3), or the id map (H, W) uint16 for a signature.
 
-    Tiles are converted to 8 bits as they arrive, so no float copy of the whole image exists.
+    Each tile is converted to 8 bits where it is traced, so no float copy of the
+    whole image ever exists.
     """
     b = job.block_size
     shape = (job.height, job.width) + (() if job.signature else (3,))
     image = np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
     stats, tiles = Stats(), list(_tiles(job))
     for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, job, tiles, workers), 1):
-        if not job.signature:
-            values = to_8bit(values, job.gamma)
         block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
         image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
         stats.add(s)
@@ -137,5 +139,5 @@ def _map_tiles(scene: Scene, job: Job, tiles: list, workers: int):
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
                              initargs=(scene,)) as pool:
         futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
-        for f in futures:
+        for f in as_completed(futures):
             yield f.result()
