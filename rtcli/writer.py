@@ -44,12 +44,19 @@ def write_png(path: str, pixels: np.ndarray) -> None:
     try:
         with os.fdopen(fd, "wb") as f:
             img.save(f, format="PNG")
+        os.chmod(tmp, 0o666 & ~_umask())               # as a plain open() would (mkstemp makes 0600)
         os.replace(tmp, path)
     except BaseException as e:
         os.unlink(tmp)
         if isinstance(e, OSError):
             raise RtcliError(f"cannot write {path}: {e.strerror or e}") from None
         raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def palette(count: int) -> np.ndarray:

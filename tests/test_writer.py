@@ -32,6 +32,17 @@ def test_same_pixels_same_bytes(tmp_path):
     assert (tmp_path / "a.png").read_bytes() == (tmp_path / "b.png").read_bytes()
 
 
+def test_output_has_ordinary_permissions(tmp_path):
+    """The atomically written file gets the umask's permissions, not the temp file's 0600."""
+    import os
+    old = os.umask(0o022)
+    try:
+        write_png(str(tmp_path / "a.png"), np.zeros((2, 2, 3), np.uint8))
+    finally:
+        os.umask(old)
+    assert (tmp_path / "a.png").stat().st_mode & 0o777 == 0o644
+
+
 def test_ids_round_trip_16_bit(tmp_path):
     """Signature ids are stored exactly as 16-bit gray."""
     ids = np.array([[0, 1, 2], [300, 65535, 7]], dtype=np.uint16)
