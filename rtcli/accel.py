@@ -69,7 +69,7 @@ class Accelerator:
             t, prim = object_hit(scene.objects[k], o, d, t_min, hits.t)
             closer = t < hits.t
             hits.t[closer], hits.obj[closer], hits.prim[closer] = t[closer], k, prim[closer]
-        if kernels.ENABLED and self.all_spheres:
+        if kernels.available() and self.all_spheres:
             t, member = kernels.traverse(self.bvh, o, d, t_min, hits.t, 1, *self.kernel_args)
             won = member >= 0
             hits.t[won], hits.obj[won], hits.prim[won] = t[won], self.members[member[won]], 0
@@ -100,7 +100,7 @@ class Accelerator:
                 t, _ = object_hit(scene.objects[k], points[todo], d[todo], 0.0, 1.0)
                 blocked[todo] = np.isfinite(t)
         todo = np.flatnonzero(~blocked)
-        if kernels.ENABLED and self.all_spheres:
+        if kernels.available() and self.all_spheres:
             blocked[todo] = kernels.traverse(self.bvh, points[todo], d[todo], 0.0, 1.0, 1,
                                              *self.kernel_shadow, any_hit=True)
             return blocked

@@ -37,10 +37,10 @@ class BVH:
         lo, hi = (np.asarray(x, dtype=float).reshape(-1, 3) for x in (lo, hi))
         self.m = len(lo)
         if self.m == 0:
-            self.box = (np.full(3, np.inf), np.full(3, -np.inf))
+            self.box, self.depth = (np.full(3, np.inf), np.full(3, -np.inf)), 0
             return
         self.box = (lo.min(axis=0), hi.max(axis=0))
-        self.lo, self.hi, self.child, self.start, self.count, self.perm = _build(lo, hi, leaf_size, bins)
+        self.lo, self.hi, self.child, self.start, self.count, self.perm, self.depth = _build(lo, hi, leaf_size, bins)
         pad = PAD * max(np.abs(np.concatenate(self.box)).max(), np.finfo(float).tiny)
         self.lo, self.hi = np.ascontiguousarray((self.lo - pad).T), np.ascontiguousarray((self.hi + pad).T)
 
@@ -169,7 +169,7 @@ def _build(lo, hi, leaf_size, bins):
         if len(count):
             work, count = _split(work, count, lo, hi, center, bins)
     columns = [np.concatenate(c) for c in zip(*levels)]
-    return (*columns, np.concatenate(perm))
+    return (*columns, np.concatenate(perm), len(levels))
 
 
 def _split(work, count, lo, hi, center, bins):

@@ -23,7 +23,6 @@ import os
 import numpy as np
 
 ENABLED = os.environ.get("RTCLI_NUMBA", "1") != "0" and importlib.util.find_spec("numba") is not None
-STACK = 64                                             # deeper than any binned-SAH tree we build
 _compiled = False
 
 
@@ -40,7 +39,7 @@ def _slab(o, inv, lo, hi, node, t_near, t_far):
 
 
 def _triangle(o, d, a, e1, e2):
-    """t of o + t d in the triangle a + alpha e1 + beta e2, or inf (planar._solve's operations)."""
+    """t of o + t d in the triangle a + alpha e1 + beta e2, or inf (planar.triangle_solve's operations)."""
     p0, p1, p2 = d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]
     det = p0 * e1[0] + p1 * e1[1] + p2 * e1[2]
     if det == 0.0:
@@ -75,12 +74,12 @@ def _sphere(o, d, c, r2, t_min, t_max):
     return t if t_min < t < t_max else np.inf
 
 
-def _traverse(o, d, t_min, t_max, lo, hi, child, start, count, perm, kind, prim_a, prim_b, prim_c,
+def _traverse(o, d, t_min, t_max, lo, hi, child, start, count, perm, depth, kind, prim_a, prim_b, prim_c,
               any_hit):
     """Nearest (or any) primitive hit per ray. kind 0: triangles (a, e1, e2); 1: spheres (c, r2, casts)."""
     n = o.shape[0]
     best, won = t_max.copy(), np.full(n, -1, np.int64)
-    stack = np.empty(STACK, np.int64)
+    stack = np.empty(depth + 2, np.int64)              # depth-first, two children pushed per level
     inv = np.empty(3)
     for i in range(n):
         for k in range(3):
@@ -113,14 +112,22 @@ def _traverse(o, d, t_min, t_max, lo, hi, child, start, count, perm, kind, prim_
 
 def _compile() -> None:
     """Swap the plain functions for numba-compiled ones (cached on disk by numba)."""
-    global _slab, _triangle, _sphere, _traverse, _compiled
+    global _slab, _triangle, _sphere, _traverse, _compiled, ENABLED
     _compiled = True
     try:
         from numba import njit
-    except ImportError:                                # stay plain Python
+    except ImportError:                                # a broken install: back to the numpy traversal
+        ENABLED = False
         return
     _slab, _triangle, _sphere = (njit(cache=True)(f) for f in (_slab, _triangle, _sphere))
     _traverse = njit(cache=True)(_traverse)
+
+
+def available() -> bool:
+    """Whether callers should use the compiled traversal (numba is loaded on the first call)."""
+    if ENABLED and not _compiled:
+        _compile()
+    return ENABLED
 
 
 def traverse(bvh, o, d, t_min, t_max, kind, a, b, c, any_hit=False):
@@ -134,7 +141,7 @@ def traverse(bvh, o, d, t_min, t_max, kind, a, b, c, any_hit=False):
         return (np.zeros(n, bool) if any_hit else (np.full(n, np.inf), np.full(n, -1, np.int64)))
     t, prim = _traverse(np.ascontiguousarray(o, dtype=float), np.ascontiguousarray(d, dtype=float),
                         t_min, t_max, bvh.lo, bvh.hi, bvh.child, bvh.start, bvh.count, bvh.perm,
-                        kind, a, b, c, any_hit)
+                        bvh.depth, kind, a, b, c, any_hit)
     if any_hit:
         return prim >= 0
     return np.where(prim >= 0, t, np.inf), prim
@@ -142,7 +149,7 @@ def traverse(bvh, o, d, t_min, t_max, kind, a, b, c, any_hit=False):
 
 def warm_up() -> None:
     """Load (or compile) the kernel now, so worker processes forked later inherit it."""
-    if ENABLED:
+    if available():
         from rtcli.bvh import BVH
         one = np.zeros((1, 3))
         traverse(BVH(one, one + 1), one, one + 1, 0.0, np.inf, 0, one, one, one)

@@ -68,3 +68,16 @@ def test_sphere_set_equals_numpy(yaml_scene, monkeypatch):
     np.testing.assert_array_equal(fast.t, slow.t)
     np.testing.assert_array_equal(fast.obj, slow.obj)
     np.testing.assert_array_equal(fast_blocked, slow_blocked)
+
+
+def test_deep_tree_does_not_overflow_the_stack():
+    """Triangles growing geometrically make a tree deeper than any fixed stack; still exact."""
+    m = 500
+    x = 1.5 ** np.arange(m) / 1.5 ** (m / 2)
+    a = np.stack([x, 0 * x, 0 * x], 1)
+    v = np.concatenate([a, a + np.stack([0.1 * x, 0 * x, 0 * x], 1), a + np.stack([0 * x, 0.1 * x, 0 * x], 1)])
+    mesh = Mesh(v, np.stack([np.arange(m), np.arange(m) + m, np.arange(m) + 2 * m], 1))
+    assert mesh.bvh.depth > 64
+    o, d = np.array([[x[5] * 1.01, 0.01 * x[5], 1.0]]), np.array([[0, 0, -1.0]])
+    t, prim = kernels.traverse(mesh.bvh, o, d, 0.0, np.inf, 0, mesh.a, mesh.e1, mesh.e2)
+    assert (t[0], prim[0]) == (1.0, 5)

@@ -66,13 +66,13 @@ class Mesh:
     # --- intersection ---
     def intersect(self, o, d, t_min, t_max):
         """Nearest triangle hit in (t_min, t_max): (t, prim), inf and -1 for a miss."""
-        if kernels.ENABLED:
+        if kernels.available():
             return kernels.traverse(self.bvh, o, d, t_min, t_max, 0, self.a, self.e1, self.e2)
         return self.bvh.intersect(o, d, t_min, t_max, self._pair_test(o, d, t_min))
 
     def any_hit(self, o, d, t_min, t_max):
         """(n,) bool: some triangle is hit in (t_min, t_max) (shadow feelers)."""
-        if kernels.ENABLED:
+        if kernels.available():
             return kernels.traverse(self.bvh, o, d, t_min, t_max, 0, self.a, self.e1, self.e2, any_hit=True)
         return self.bvh.any_hit(o, d, t_min, t_max, self._pair_test(o, d, t_min))
 
