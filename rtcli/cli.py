@@ -173,11 +173,13 @@ def compare(actual, expected, diff, ids_mode, tolerance, max_bad_pixels, max_bad
     from rtcli import compare as cmp
     from rtcli.writer import write_png
     a, e = cmp.read_png(actual), cmp.read_png(expected)
+    id_options = dict(max_boundary_mismatch=max_boundary_mismatch, max_boundary_fraction=max_boundary_fraction)
+    image_options = dict(tolerance=tolerance, max_bad_pixels=max_bad_pixels,
+                         max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
     if ids_mode:
-        result = cmp.compare_ids(a, e, max_boundary_mismatch, max_boundary_fraction)
+        result = cmp.compare_ids(a, e, **id_options)
     else:
-        result = cmp.compare(a, e, tolerance=tolerance, max_bad_pixels=max_bad_pixels,
-                             max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
+        result = cmp.compare(a, e, image_options, id_options)
     if diff and a.shape == e.shape and a.ndim == 3:
         write_png(diff, cmp.heat_map(a, e, tolerance))
     click.echo(result.summary)

@@ -144,8 +144,10 @@ def compare_ids(actual, expected, max_boundary_mismatch: int = 8,
                       boundary_pixels=n_boundary)
 
 
-def compare(actual: np.ndarray, expected: np.ndarray, **options) -> Comparison:
-    """Dispatch on what read_png returned: (H, W, 3) -> compare_images, (H, W) -> compare_ids."""
+def compare(actual: np.ndarray, expected: np.ndarray, image_options: dict | None = None,
+            id_options: dict | None = None) -> Comparison:
+    """Dispatch on what read_png returned: (H, W, 3) -> compare_images, (H, W) -> compare_ids,
+    each with its own options."""
     actual, expected = np.asarray(actual), np.asarray(expected)
     if {actual.ndim, expected.ndim} == {2, 3}:
         if (differs := _size_differs(actual, expected)) is not None:
@@ -153,7 +155,9 @@ def compare(actual: np.ndarray, expected: np.ndarray, **options) -> Comparison:
         kind = {2: "an id map", 3: "an RGB image"}
         return Comparison(False, f"FAIL: kind differs: actual is {kind[actual.ndim]}, "
                                  f"expected is {kind[expected.ndim]}")
-    return (compare_ids if actual.ndim == 2 else compare_images)(actual, expected, **options)
+    if actual.ndim == 2:
+        return compare_ids(actual, expected, **(id_options or {}))
+    return compare_images(actual, expected, **(image_options or {}))
 
 
 def heat_map(actual, expected, tolerance: int = 2) -> np.ndarray:

@@ -92,3 +92,16 @@ def test_compare_exit_codes(run, tmp_path):
     assert result.exit_code == 1
     assert result.output.startswith("FAIL") and (tmp_path / "d.png").exists()
     assert run("compare", "a.png", "missing.png").exit_code == 2
+
+
+def test_compare_id_maps_without_the_ids_flag(run, tmp_path):
+    """Two 16-bit id maps are compared as id maps even without --ids."""
+    ids = np.zeros((20, 20), np.uint16)
+    ids[5:15, 5:15] = 3
+    Image.fromarray(ids).save(tmp_path / "a.png")
+    other = ids.copy()
+    other[8:12, 8:12] = 4
+    Image.fromarray(other).save(tmp_path / "b.png")
+    assert run("compare", "a.png", "a.png").exit_code == 0
+    result = run("compare", "a.png", "b.png")
+    assert result.exit_code == 1 and "mismatched ids" in result.output
