@@ -152,9 +152,17 @@ def _fields(tokens, at):
         try:
             out.append(np.array(text, dtype=np.int64))
         except (ValueError, OverflowError):
-            k = next(i for i, x in enumerate(text) if not re.fullmatch(r"[+-]?\d{1,18}", x))
+            k = next(i for i, x in enumerate(text) if not _is_index(x))
             raise at(k, f"bad index in face corner '{tokens[k]}'") from None
     return out
+
+
+def _is_index(text: str) -> bool:
+    """An integer that fits an int64 (the empty-field placeholder counts)."""
+    try:
+        return np.iinfo(np.int64).min <= int(text) <= np.iinfo(np.int64).max
+    except ValueError:
+        return False
 
 
 def _resolve(raw, count_before, total, names, at):

@@ -64,6 +64,7 @@ def test_vt_with_one_number_and_v_with_w():
      "t.obj:5:7: texture index 2 out of range: 1 texture coordinates (vt) defined"),
     (TRIANGLE + "f 1//1 2//1 3//1\n", "t.obj:4:3: normal index 1 out of range: 0 normals (vn) defined"),
     (TRIANGLE + "f 1 2.0 3\n", "t.obj:4:5: bad index in face corner '2.0'"),
+    (TRIANGLE + "vn 0 0 1\nf 1//1 2//1 3//x\n", "t.obj:5:13: bad index in face corner '3//x'"),
     (TRIANGLE + "f 1/1/1/1 2 3\n", "t.obj:4:3: bad face corner '1/1/1/1' (more than v/vt/vn)"),
     (TRIANGLE + "f 1 //1 3\n", "t.obj:4:5: face corner '//1' has no vertex index"),
 ])
