@@ -115,3 +115,12 @@ def test_csg_of_a_triangle_is_an_error(yaml_scene):
         """)
     assert str(e.value).endswith("objects[0].csg.union[1]: a csg child must be a solid: "
                                  "sphere, plane, box, cylinder, cone (capped), torus or csg")
+
+
+def test_touching_solids_have_no_inner_face():
+    """Boxes meeting at x = 0: their union is one span, so no face inside it."""
+    from rtcli.shapes.box import Box
+    left, right = Child(Box((-1, -1, -1), (0, 1, 1)), None, 1), Child(Box((0, -1, -1), (1, 1, 1)), None, 1)
+    np.testing.assert_allclose(spans_of("union", (left, right)), [(4, 6)])
+    t, _ = CSG("union", [left, right]).intersect(np.array([[-0.5, 0, 0]]), D, np.array([0.0]), np.inf)
+    assert t[0] == pytest.approx(1.5)

@@ -85,7 +85,7 @@ class CSG:
 
     def spans(self, o, d):
         t, delta, owner, prim = self._events(o, d)
-        order = np.argsort(t, axis=1, kind="stable")
+        order = np.lexsort((-delta, t), axis=1)         # by t; at equal t, entries before exits
         t, delta, prim = (np.take_along_axis(a, order, axis=1) for a in (t, delta, prim))
         owner = owner[order]
         inside = np.stack([np.cumsum(np.where(owner == c, delta, 0), axis=1) > 0
@@ -99,7 +99,7 @@ class CSG:
     def intersect(self, o, d, t_min, t_max):
         t_in, p_in, t_out, p_out = self.spans(o, d)
         t, prim = np.concatenate([t_in, t_out], axis=1), np.concatenate([p_in, p_out], axis=1)
-        t = np.where((t > t_min) & (t < np.reshape(t_max, (-1, 1))), t, np.inf)
+        t = np.where((t > np.reshape(t_min, (-1, 1))) & (t < np.reshape(t_max, (-1, 1))), t, np.inf)
         k = np.argmin(t, axis=1)
         rows = np.arange(len(o))
         return t[rows, k], prim[rows, k]
