@@ -26,8 +26,8 @@ from __future__ import annotations
 import numpy as np
 
 CHUNK = 1 << 13                         # rays traversed together
-PAD = 1e-9                              # node boxes grow by PAD x scene size, so rounding in the slab
-                                        # test cannot drop a hit lying on a box face
+PAD = 1e-9                              # boxes grow by PAD x their largest |coordinate|, so rounding in
+                                        # the slab test cannot drop a hit lying on a box face
 
 
 class BVH:
@@ -41,8 +41,7 @@ class BVH:
             return
         self.box = (lo.min(axis=0), hi.max(axis=0))
         self.lo, self.hi, self.child, self.start, self.count, self.perm, self.depth = _build(lo, hi, leaf_size, bins)
-        pad = PAD * max(np.abs(np.concatenate(self.box)).max(), np.finfo(float).tiny)
-        self.lo, self.hi = np.ascontiguousarray((self.lo - pad).T), np.ascontiguousarray((self.hi + pad).T)
+        self.lo, self.hi = (np.ascontiguousarray(x.T) for x in padded(self.lo, self.hi, self.box))
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """The union of the primitives' boxes (inf, -inf when there are none)."""
@@ -115,6 +114,13 @@ class BVH:
         r = np.repeat(rays, count)
         offset = np.arange(len(r)) - np.repeat(np.cumsum(count) - count, count)
         return r, self.perm[np.repeat(self.start[nodes], count) + offset]
+
+
+def padded(lo, hi, scale_box=None):
+    """lo, hi grown by PAD x the largest |coordinate| (of scale_box, default of lo and hi)."""
+    ref = np.concatenate([np.ravel(x) for x in (scale_box if scale_box is not None else (lo, hi))])
+    pad = PAD * max(np.abs(ref).max(), np.finfo(float).tiny)
+    return lo - pad, hi + pad
 
 
 def slab(o, inv, lo, hi, t_min, t_max):

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rtcli.bvh import padded
 from rtcli.materials import MaterialTable
 from rtcli.transform import Transform, bounds_of_box
 
@@ -58,8 +59,8 @@ class Scene:
 
     @functools.cached_property
     def boxes(self) -> list:
-        """Each object's world-space box (lo, hi), or None when it is unbounded."""
-        return [o.bounds() for o in self.objects]
+        """Each object's world-space box (lo, hi), padded as the BVH's, or None when unbounded."""
+        return [None if b is None else padded(*b) for b in (o.bounds() for o in self.objects)]
 
     @functools.cached_property
     def size(self) -> float:

@@ -69,3 +69,23 @@ def test_bvh_render_is_identical(yaml_scene):
     scene.accel = Accelerator(scene)
     fast, _ = render(scene, Job(64, 48))
     np.testing.assert_array_equal(fast, brute)
+
+
+def test_box_culling_keeps_edge_hits_of_flat_shapes(yaml_scene):
+    """Rays aimed at a rotated square's edges hit it exactly as the shape's own test says."""
+    from rtcli.intersect import object_hit
+    scene = yaml_scene("""
+        camera: {eye: [0, 5, 0], look_at: [0, 0, 0], up: [0, 0, 1]}
+        objects:
+          - {square: {}, transform: [{rotate: {axis: [1, 0, 0], degrees: 90}}, {scale: 3}, {translate: [0.1, 0.7, 0.3]}]}
+    """)
+    rng = np.random.default_rng(2)
+    edge = rng.uniform(-3, 3, 20000)
+    side = rng.integers(0, 2, 20000) * 6 - 3.0
+    target = np.where(rng.integers(0, 2, 20000)[:, None] == 1, np.stack([edge, side], 1), np.stack([side, edge], 1))
+    points = np.stack([target[:, 0] + 0.1, np.full(20000, 0.7), target[:, 1] + 0.3], 1)
+    o = points + rng.normal(size=(20000, 3)) * [1, 0, 1] + [0, 4, 0]
+    rays = Rays(o, points - o)
+    direct, _ = object_hit(scene.objects[0], rays.origin, rays.direction, 0.0, np.inf)
+    assert np.isfinite(direct).sum() > 1000
+    np.testing.assert_array_equal(find_first_hit(scene, rays).t, direct)
