@@ -13,28 +13,28 @@ import numpy as np
 
 from rtcli import kernels
 from rtcli.bvh import BVH
+from rtcli.intersect import blocked_by, blocks, nearest_over, no_hits, object_hit
 from rtcli.shapes.sphere import Sphere, nearest_root, sphere_roots
 
 MIN_OBJECTS = 8            # below this many bounded objects the plain loop is faster
 
 
 class Accelerator:
+    """The scene's unbounded objects, and a BVH over its bounded ones."""
+
     def __init__(self, scene):
-        objects = scene.objects
-        boxes = [o.bounds() for o in objects]
+        objects, boxes = scene.objects, scene.boxes
         self.unbounded = [k for k, b in enumerate(boxes) if b is None]
         self.members = np.array([k for k, b in enumerate(boxes) if b is not None], dtype=np.int64)
         self.bvh = BVH(np.array([boxes[k][0] for k in self.members]).reshape(-1, 3),
                        np.array([boxes[k][1] for k in self.members]).reshape(-1, 3), leaf_size=2)
-        is_sphere = np.array([isinstance(objects[k].shape, Sphere) and objects[k].world_from_object is None
-                              for k in self.members], dtype=bool)
-        self.is_sphere = np.zeros(len(objects), dtype=bool)     # by object index, for surface()
-        self.is_sphere[self.members[is_sphere]] = True
+        self.is_sphere = np.array([b is not None and isinstance(o.shape, Sphere) and o.world_from_object is None
+                                   for o, b in zip(objects, boxes)], dtype=bool)     # by object index
         self.center = np.array([o.shape.center if s else np.zeros(3) for o, s in zip(objects, self.is_sphere)])
         self.radius = np.array([o.shape.radius if s else 1.0 for o, s in zip(objects, self.is_sphere)])
         self.material = np.array([o.material for o in objects], dtype=np.int64)
         self.shadow = scene.materials.shadow[self.material]
-        self.all_spheres = bool(is_sphere.all())       # then the compiled traversal can do it all
+        self.all_spheres = bool(self.is_sphere[self.members].all())    # the compiled traversal can do it all
         k = self.members
         self.kernel_args = (self.center[k], (self.radius[k] ** 2)[:, None], np.ones((len(k), 1)))
         self.kernel_shadow = (self.center[k], (self.radius[k] ** 2)[:, None],
@@ -42,69 +42,64 @@ class Accelerator:
 
     @staticmethod
     def wanted(scene) -> bool:
-        return sum(o.bounds() is not None for o in scene.objects) >= MIN_OBJECTS
+        """Whether the scene has enough bounded objects for the BVH to pay."""
+        return sum(b is not None for b in scene.boxes) >= MIN_OBJECTS
 
-    def _pair_test(self, scene, o, d, t_min, r, m, t_max, only_shadow=False):
+    def _pair_test(self, scene, o, d, t_min, r, m, t_max):
         """(t, prim) of (ray r, member m) pairs in (t_min, t_max)."""
-        from rtcli.intersect import object_hit
         obj = self.members[m]
         t, prim = np.full(len(r), np.inf), np.zeros(len(r), dtype=np.int64)
-        keep = self.shadow[obj] if only_shadow else np.ones(len(r), dtype=bool)
-        sph = keep & self.is_sphere[obj]
+        sph = self.is_sphere[obj]
         if sph.any():
             k = obj[sph]
             roots = sphere_roots(o[r[sph]] - self.center[k], d[r[sph]], self.radius[k] ** 2)
             t[sph] = nearest_root(*roots, t_min, t_max[sph])
-        rest = np.flatnonzero(keep & ~sph)
+        rest = np.flatnonzero(~sph)
         for k in np.unique(obj[rest]):
             rows = rest[obj[rest] == k]
             t[rows], prim[rows] = object_hit(scene.objects[k], o[r[rows]], d[r[rows]], t_min, t_max[rows])
         return t, prim
 
+    def _pair_blocks(self, scene, o, d, r, m):
+        """Shadow feelers r (0 < t < 1) against members m: finite where blocked."""
+        obj = self.members[m]
+        blocked = np.zeros(len(r), dtype=bool)
+        sph = self.shadow[obj] & self.is_sphere[obj]
+        if sph.any():
+            k = obj[sph]
+            roots = sphere_roots(o[r[sph]] - self.center[k], d[r[sph]], self.radius[k] ** 2)
+            blocked[sph] = np.isfinite(nearest_root(*roots, 0.0, 1.0))
+        rest = np.flatnonzero(self.shadow[obj] & ~sph)
+        for k in np.unique(obj[rest]):
+            rows = rest[obj[rest] == k]
+            blocked[rows] = blocks(scene.objects[k], o[r[rows]], d[r[rows]], 0.0, 1.0)
+        return np.where(blocked, 0.5, np.inf)
+
     def first_hit(self, scene, rays, t_min):
-        from rtcli.intersect import Hits, object_hit
-        o, d, n = rays.origin, rays.direction, len(rays)
-        hits = Hits(np.full(n, np.inf), np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=np.int64))
-        for k in self.unbounded:
-            t, prim = object_hit(scene.objects[k], o, d, t_min, hits.t)
-            closer = t < hits.t
-            hits.t[closer], hits.obj[closer], hits.prim[closer] = t[closer], k, prim[closer]
+        """find_first_hit through the BVH."""
+        o, d = rays.origin, rays.direction
+        hits = no_hits(len(rays))
+        nearest_over(scene, self.unbounded, rays, t_min, hits)
         if kernels.available() and self.all_spheres:
             t, member = kernels.traverse(self.bvh, o, d, t_min, hits.t, 1, *self.kernel_args)
-            won = member >= 0
-            hits.t[won], hits.obj[won], hits.prim[won] = t[won], self.members[member[won]], 0
-            return hits
-        best, sub = hits.t.copy(), np.zeros(n, dtype=np.int64)
-
-        def pairs(r, m, t_max):
-            t, prim = self._pair_test(scene, o, d, t_min, r, m, t_max)
-            hit = t < best[r]                  # mirrors the BVH's bookkeeping, to keep each winner's prim
-            r_hit, t_hit = r[hit], t[hit]
-            np.minimum.at(best, r_hit, t_hit)
-            won = t_hit == best[r_hit]
-            sub[r_hit[won]] = prim[hit][won]
-            return t
-
-        t, member = self.bvh.intersect(o, d, t_min, hits.t, pairs)
+            sub = np.zeros(len(rays), dtype=np.int64)
+        else:
+            sub = np.zeros(len(rays), dtype=np.int64)
+            pairs = lambda r, m, t_max: self._pair_test(scene, o, d, t_min, r, m, t_max)
+            t, member = self.bvh.intersect(o, d, t_min, hits.t, pairs, sub)
         won = member >= 0
         hits.t[won], hits.obj[won], hits.prim[won] = t[won], self.members[member[won]], sub[won]
         return hits
 
     def occluded(self, scene, points, lights):
-        from rtcli.intersect import object_hit
+        """occluded() through the BVH: feelers stop at their first blocker."""
         d = lights - points
         blocked = np.zeros(len(points), dtype=bool)
-        for k in self.unbounded:
-            if self.shadow[k]:
-                todo = np.flatnonzero(~blocked)
-                t, _ = object_hit(scene.objects[k], points[todo], d[todo], 0.0, 1.0)
-                blocked[todo] = np.isfinite(t)
+        blocked_by(scene, self.unbounded, points, d, blocked)
         todo = np.flatnonzero(~blocked)
+        p, dt = points[todo], d[todo]
         if kernels.available() and self.all_spheres:
-            blocked[todo] = kernels.traverse(self.bvh, points[todo], d[todo], 0.0, 1.0, 1,
-                                             *self.kernel_shadow, any_hit=True)
-            return blocked
-        pairs = lambda r, m, t_max: self._pair_test(scene, points[todo], d[todo], 0.0, r, m, t_max, True)[0]
-        blocked[todo] = self.bvh.any_hit(points[todo], d[todo], 0.0, 1.0, pairs)
+            blocked[todo] = kernels.traverse(self.bvh, p, dt, 0.0, 1.0, 1, *self.kernel_shadow, any_hit=True)
+        else:
+            blocked[todo] = self.bvh.any_hit(p, dt, 0.0, 1.0, lambda r, m, t_max: self._pair_blocks(scene, p, dt, r, m))
         return blocked
-

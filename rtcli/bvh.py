@@ -47,24 +47,28 @@ class BVH:
         """The union of the primitives' boxes (inf, -inf when there are none)."""
         return self.box[0].copy(), self.box[1].copy()
 
-    def intersect(self, o, d, t_min, t_max, hit_pairs):
+    def intersect(self, o, d, t_min, t_max, hit_pairs, sub=None):
         """Nearest primitive along each ray: (t (n,), prim (n,)), inf and -1 for a miss.
 
         hit_pairs(rays, prims, t_max_pairs) -> t (p,) is the exact test of
         (ray, primitive) pairs: a hit in (t_min, t_max_pairs), else inf. The
         result equals that test run on every primitive (ties: lowest t, any prim).
+        With `sub` (an (n,) int array), hit_pairs returns (t, sub_pairs) instead,
+        and each ray's winning sub_pairs value (say, a face of the primitive) lands in sub.
         """
         n = len(o)
         best = np.broadcast_to(np.asarray(t_max, dtype=float), (n,)).copy()
         prim = np.full(n, -1, dtype=np.int64)
 
         def leaves(r, p):
-            t = hit_pairs(r, p, best[r])
+            t, s = hit_pairs(r, p, best[r]) if sub is not None else (hit_pairs(r, p, best[r]), None)
             hit = t < best[r]
             r, p, t = r[hit], p[hit], t[hit]
             np.minimum.at(best, r, t)                  # each ray's nearest among these pairs
             won = t == best[r]
             prim[r[won]] = p[won]
+            if sub is not None:
+                sub[r[won]] = s[hit][won]
 
         self._traverse(o, d, t_min, best, leaves)
         return np.where(prim >= 0, best, np.inf), prim

@@ -46,6 +46,14 @@ def object_hit(obj, o, d, t_min, t_max):
     return t, (np.zeros(len(o), dtype=np.int64) if prim is None else prim)
 
 
+def blocks(obj, o, d, t_min, t_max) -> np.ndarray:
+    """(n,) bool: the rays o + t d hit object obj for t_min < t < t_max (any hit will do)."""
+    o_obj, d_obj = obj.to_object(o, d)
+    if hasattr(obj.shape, "any_hit"):                  # meshes stop at their first blocking triangle
+        return obj.shape.any_hit(o_obj, d_obj, t_min, t_max)
+    return np.isfinite(obj.shape.intersect(o_obj, d_obj, t_min, t_max)[0])
+
+
 def _candidates(scene: Scene, k: int, o_cols, inv_cols, rows, t_max):
     """The rows whose ray meets object k's world box before t_max (all rows if unbounded)."""
     box = scene.boxes[k]
@@ -54,41 +62,51 @@ def _candidates(scene: Scene, k: int, o_cols, inv_cols, rows, t_max):
     return rows[slab(o_cols[:, rows], inv_cols[:, rows], box[0], box[1], 0.0, t_max)]
 
 
+def nearest_over(scene: Scene, indices, rays: Rays, t_min: float, best: Hits) -> None:
+    """Lower `best` to the nearest hit among the objects `indices`, each tested only on
+    the rays that meet its bounding box before the best hit so far."""
+    o_cols, inv_cols = columns(rays.origin, rays.direction)
+    every = np.arange(len(rays))
+    for k in indices:
+        rows = _candidates(scene, k, o_cols, inv_cols, every, best.t)
+        if len(rows):
+            t, prim = object_hit(scene.objects[k], rays.origin[rows], rays.direction[rows], t_min, best.t[rows])
+            closer = t < best.t[rows]
+            won = rows[closer]
+            best.t[won], best.obj[won], best.prim[won] = t[closer], k, prim[closer]
+
+
+def blocked_by(scene: Scene, indices, points: np.ndarray, d: np.ndarray, blocked: np.ndarray) -> None:
+    """Mark the feelers points + t d (0 < t < 1) that an object of `indices` casting shadows
+    blocks; a feeler stops at its first blocker: later objects test only the open ones."""
+    o_cols, inv_cols = columns(points, d)
+    for k in indices:
+        if scene.materials.shadow[scene.objects[k].material]:
+            todo = _candidates(scene, k, o_cols, inv_cols, np.flatnonzero(~blocked), 1.0)
+            if len(todo):
+                blocked[todo] = blocks(scene.objects[k], points[todo], d[todo], 0.0, 1.0)
+
+
+def no_hits(n: int) -> Hits:
+    return Hits(np.full(n, np.inf), np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=np.int64))
+
+
 def find_first_hit(scene: Scene, rays: Rays, t_min: float = 0.0) -> Hits:
     """Nearest hit over all objects: through the BVH when the scene has one, else
     object by object, each tested only on the rays that meet its bounding box."""
     if scene.accel is not None:
         return scene.accel.first_hit(scene, rays, t_min)
-    n = len(rays)
-    best = Hits(np.full(n, np.inf), np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=np.int64))
-    o_cols, inv_cols = columns(rays.origin, rays.direction)
-    every = np.arange(n)
-    for k, obj in enumerate(scene.objects):
-        rows = _candidates(scene, k, o_cols, inv_cols, every, best.t)
-        if len(rows):
-            t, prim = object_hit(obj, rays.origin[rows], rays.direction[rows], t_min, best.t[rows])
-            closer = t < best.t[rows]
-            won = rows[closer]
-            best.t[won], best.obj[won], best.prim[won] = t[closer], k, prim[closer]
+    best = no_hits(len(rays))
+    nearest_over(scene, range(len(scene.objects)), rays, t_min, best)
     return best
 
 
 def occluded(scene: Scene, points: np.ndarray, lights: np.ndarray) -> np.ndarray:
-    """Shadow feelers p + t (l - p): True where an object that casts shadows is hit for 0 < t < 1.
-
-    A feeler stops at its first blocker: later objects test only the rays still open.
-    """
+    """Shadow feelers p + t (l - p): True where an object that casts shadows is hit for 0 < t < 1."""
     if scene.accel is not None:
         return scene.accel.occluded(scene, points, lights)
-    d = lights - points
-    o_cols, inv_cols = columns(points, d)
     blocked = np.zeros(len(points), dtype=bool)
-    for k, obj in enumerate(scene.objects):
-        if scene.materials.shadow[obj.material]:
-            todo = _candidates(scene, k, o_cols, inv_cols, np.flatnonzero(~blocked), 1.0)
-            if len(todo):
-                t, _ = object_hit(obj, points[todo], d[todo], 0.0, 1.0)
-                blocked[todo] = np.isfinite(t)
+    blocked_by(scene, range(len(scene.objects)), points, lights - points, blocked)
     return blocked
 
 
