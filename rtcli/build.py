@@ -14,7 +14,6 @@ from rtcli import camera as cameras
 from rtcli import yamlfile
 from rtcli.accel import Accelerator
 from rtcli.build_objects import ObjectBuilder, material_from
-from rtcli.errors import SceneError
 from rtcli.lights import PointLight
 from rtcli.materials import Material, MaterialTable
 from rtcli.params import Params, as_params

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PIL import Image
 
 from rtcli import camera as cameras
 from rtcli.errors import SceneError

@@ -23,7 +23,8 @@ import numpy as np
 from rtcli import kernels
 from rtcli.bvh import BVH
 from rtcli.obj import parse_obj
-from rtcli.vec import cross, dot, length
+from rtcli.shapes.planar import barycentric, degenerate, triangle_solve
+from rtcli.vec import cross, length
 
 
 class Mesh:
@@ -34,13 +35,11 @@ class Mesh:
         if len(f) == 0:
             raise ValueError("the mesh has no faces")
         a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-        extent = np.max(np.maximum(np.maximum(a, b), c) - np.minimum(np.minimum(a, b), c), axis=1)
-        keep = length(cross(b - a, c - a)) > 1e-12 * extent * extent      # as triangle: not collinear
+        keep = ~degenerate(a, b, c)                                        # as triangle: not collinear
         if not keep.any():
             raise ValueError("all triangles of the mesh have zero area")
         self.a, self.e1, self.e2 = a[keep], (b - a)[keep], (c - a)[keep]
         self.face = cross(self.e1, self.e2)                                # outward, |face| = 2 area
-        self.smooth = bool(smooth)
         self.uv_corners = _corners(uv, uv_faces, keep)                     # (F, 3, 2) or None
         self.normal_corners = (_smooth_normals(v, f[keep], self.face, normals, normal_faces, keep)
                                if smooth else None)                       # (F, 3, 3) or None
@@ -81,7 +80,7 @@ class Mesh:
         o, d, t_min = np.asarray(o, dtype=float), np.asarray(d, dtype=float), np.asarray(t_min, dtype=float)
 
         def hit_pairs(r, p, t_max):
-            t, alpha, beta = _solve(o[r], d[r], self.a[p], self.e1[p], self.e2[p])
+            t, alpha, beta = triangle_solve(o[r], d[r], self.a[p], self.e1[p], self.e2[p])
             lo = t_min if t_min.ndim == 0 else t_min[r]
             inside = (alpha >= 0) & (beta >= 0) & (alpha + beta <= 1)
             return np.where(inside & (t > lo) & (t < t_max), t, np.inf)
@@ -90,11 +89,7 @@ class Mesh:
     # --- surface ---
     def barycentric(self, p, prim):
         """(alpha, beta) of points p in the planes of triangles prim (weights of b and c)."""
-        e1, e2, q = self.e1[prim], self.e2[prim], p - self.a[prim]
-        d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
-        d20, d21 = dot(q, e1), dot(q, e2)
-        den = d00 * d11 - d01 * d01
-        return (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+        return barycentric(p - self.a[prim], self.e1[prim], self.e2[prim])
 
     def geometric_normal(self, p, prim):
         return self.face[prim]
@@ -115,23 +110,6 @@ class Mesh:
 
     def bounds(self):
         return self.bvh.bounds()
-
-
-def _solve(o, d, a, e1, e2):
-    """Solve o + t d = a + alpha e1 + beta e2 by Cramer's rule (notes 000 11.3.1).
-
-    The same operations as Triangle._solve, row by row, so both give the same t bit for bit.
-    """
-    pvec = cross(d, e2)
-    det = dot(pvec, e1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / det
-        tvec = o - a
-        alpha = dot(tvec, pvec) * inv
-        qvec = cross(tvec, e1)
-        beta = dot(d, qvec) * inv
-        t = dot(qvec, e2) * inv
-    return t, alpha, beta
 
 
 def _interpolate(corners, alpha, beta):

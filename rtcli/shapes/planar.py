@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.vec import cross, dot, normalize
+from rtcli.vec import cross, dot, length, normalize
 
 
 def _plane_t(o, d, point, n, t_min, t_max):
@@ -24,6 +24,37 @@ def _in_plane_basis(n):
     helper = np.array([1.0, 0, 0]) if abs(n[0]) < 0.9 else np.array([0, 0, 1.0])
     e2 = normalize(cross(n, helper))
     return normalize(cross(e2, n)), e2
+
+
+def triangle_solve(o, d, a, e1, e2):
+    """Solve o + lambda d = a + alpha e1 + beta e2 by Cramer's rule (notes 000 11.3.1): (t, alpha, beta).
+
+    Inside the triangle when alpha >= 0, beta >= 0 and alpha + beta <= 1.
+    """
+    pvec = cross(d, e2)
+    det = dot(pvec, e1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / det
+        tvec = o - a
+        alpha = dot(tvec, pvec) * inv
+        qvec = cross(tvec, e1)
+        beta = dot(d, qvec) * inv
+        t = dot(qvec, e2) * inv
+    return t, alpha, beta
+
+
+def barycentric(q, e1, e2):
+    """(alpha, beta) of the in-plane offsets q = p - a along the edges e1, e2."""
+    d00, d01, d11 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
+    d20, d21 = dot(q, e1), dot(q, e2)
+    den = d00 * d11 - d01 * d01
+    return (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+
+
+def degenerate(a, b, c):
+    """Triangles whose corners are (nearly) collinear: |(b - a) x (c - a)| <= 1e-12 extent^2."""
+    extent = np.max(np.maximum(np.maximum(a, b), c) - np.minimum(np.minimum(a, b), c), axis=-1)
+    return length(cross(b - a, c - a)) <= 1e-12 * extent * extent
 
 
 class Plane:
@@ -87,38 +118,20 @@ class Triangle:
     def from_params(cls, p):
         v = p.vectors("vertices", count=3)
         normals = p.vectors("normals", count=3, default=None)
-        scale = max(np.ptp(v, axis=0).max(), 1e-300)
-        if np.linalg.norm(cross(v[1] - v[0], v[2] - v[0])) <= 1e-12 * scale * scale:
+        if degenerate(*v):
             raise p.error("vertices", "degenerate triangle (its vertices are collinear)")
         if normals is not None and np.any(np.linalg.norm(normals, axis=1) == 0):
             raise p.error("normals", "a vertex normal must not be the zero vector")
         return cls(*v, normals=normals)
 
-    def _solve(self, o, d):
-        """Solve a + lambda d = p1 + alpha (p2 - p1) + beta (p3 - p1) by Cramer's rule."""
-        pvec = cross(d, self.e2)
-        det = dot(pvec, self.e1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            inv = 1.0 / det
-            tvec = o - self.a
-            alpha = dot(tvec, pvec) * inv
-            qvec = cross(tvec, self.e1)
-            beta = dot(d, qvec) * inv
-            t = dot(qvec, self.e2) * inv
-        return t, alpha, beta
-
     def intersect(self, o, d, t_min, t_max):
-        t, alpha, beta = self._solve(o, d)
+        t, alpha, beta = triangle_solve(o, d, self.a, self.e1, self.e2)
         inside = (alpha >= 0) & (beta >= 0) & (alpha + beta <= 1)
         return np.where(inside & (t > t_min) & (t < t_max), t, np.inf), None
 
     def barycentric(self, p):
         """(alpha, beta) of points p in the triangle's plane."""
-        q = p - self.a
-        d00, d01, d11 = dot(self.e1, self.e1), dot(self.e1, self.e2), dot(self.e2, self.e2)
-        d20, d21 = dot(q, self.e1), dot(q, self.e2)
-        den = d00 * d11 - d01 * d01
-        return (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+        return barycentric(p - self.a, self.e1, self.e2)
 
     def geometric_normal(self, p, prim):
         return np.broadcast_to(self.face, p.shape)
