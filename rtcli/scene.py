@@ -9,7 +9,7 @@ import numpy as np
 
 from rtcli.bvh import padded
 from rtcli.materials import MaterialTable
-from rtcli.transform import Transform, bounds_of_box
+from rtcli.transform import Transform, outer_bounds, ray_into
 
 
 @dataclass
@@ -22,17 +22,12 @@ class SceneObject:
     kind: str = ""                   # the YAML shape name, for legends
 
     def to_object(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The ray in object space: inverse-transformed start and direction (notes 000 11.3.4)."""
-        if self.world_from_object is None:
-            return o, d
-        inv = self.world_from_object.inverse
-        return inv.point(o), inv.vector(d)
+        """The ray in object space (notes 000 11.3.4)."""
+        return ray_into(self.world_from_object, o, d)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray] | None:
-        b = self.shape.bounds()
-        if b is None or self.world_from_object is None:
-            return b
-        return bounds_of_box(self.world_from_object, *b)
+        """World-space box, or None when unbounded."""
+        return outer_bounds(self.world_from_object, self.shape.bounds())
 
 
 @dataclass

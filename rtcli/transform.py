@@ -86,3 +86,21 @@ def bounds_of_box(t: Transform, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndar
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     p = t.point(corners)
     return p.min(axis=0), p.max(axis=0)
+
+
+def ray_into(world_from_object: Transform | None, o: np.ndarray, d: np.ndarray):
+    """The ray o + t d in object space: inverse-transformed start and direction (notes 000 11.3.4).
+
+    t keeps its meaning. None means the object space is the world space.
+    """
+    if world_from_object is None:
+        return o, d
+    inv = world_from_object.inverse
+    return inv.point(o), inv.vector(d)
+
+
+def outer_bounds(world_from_object: Transform | None, box):
+    """The world box around an object-space box (lo, hi), or None for an unbounded shape."""
+    if box is None or world_from_object is None:
+        return box
+    return bounds_of_box(world_from_object, *box)

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.transform import Transform, bounds_of_box
+from rtcli.transform import Transform, outer_bounds, ray_into
 
 OPS = ("union", "intersection", "difference")
 
@@ -32,10 +32,7 @@ class Child:
     material: int
 
     def to_child(self, o, d):
-        if self.transform is None:
-            return o, d
-        inv = self.transform.inverse
-        return inv.point(o), inv.vector(d)
+        return ray_into(self.transform, o, d)
 
 
 def csg_from(p, builder, material: int) -> "CSG":
@@ -130,15 +127,21 @@ class CSG:
         return self._per_child(p, prim, lambda c, child, p_c, cp: child.shape.uv(p_c, cp))
 
     def material_of(self, prim, default: int):
-        """Each hit's material: the child's (a nested csg asks its own children)."""
-        def material(c, child, p_c, cp):
-            if hasattr(child.shape, "material_of"):
-                return child.shape.material_of(cp, child.material)
-            return np.full(len(cp), child.material)
-        return self._per_child(np.zeros((len(prim), 3)), prim, material)
+        """Each hit's material: the child's (a nested csg asks its own children).
+
+        `default` (the object's material) is already each child's default, from build.
+        """
+        C = len(self.children)
+        out = np.empty(len(prim), dtype=np.int64)
+        for c in np.unique(prim % C):
+            rows = prim % C == c
+            child = self.children[c]
+            nested = getattr(child.shape, "material_of", None)
+            out[rows] = nested(prim[rows] // C, child.material) if nested else child.material
+        return out
 
     def bounds(self):
-        boxes = [_child_bounds(ch) for ch in self.children]
+        boxes = [outer_bounds(ch.transform, ch.shape.bounds()) for ch in self.children]
         if self.op == "difference":
             return boxes[0]
         finite = [b for b in boxes if b is not None]
@@ -147,13 +150,6 @@ class CSG:
                                                            np.max([b[1] for b in finite], axis=0))
         return None if not finite else (np.max([b[0] for b in finite], axis=0),
                                         np.min([b[1] for b in finite], axis=0))
-
-
-def _child_bounds(child: Child):
-    b = child.shape.bounds()
-    if b is None or child.transform is None:
-        return b
-    return bounds_of_box(child.transform, *b)
 
 
 def _compact(mask, t, prim):
