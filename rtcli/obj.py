@@ -65,7 +65,10 @@ def parse_obj(text: str, display: str) -> ObjData:
 
 
 def read_obj(path: str, display: str | None = None) -> ObjData:
-    """Read and parse an OBJ file (OSError if it cannot be read)."""
+    """Read and parse an OBJ file (OSError if it cannot be read).
+
+    OBJ is ASCII; bytes that are not UTF-8 (in comments, say) are replaced, not refused.
+    """
     with open(path, encoding="utf-8", errors="replace") as f:
         return parse_obj(f.read(), display or path)
 

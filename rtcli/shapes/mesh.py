@@ -22,7 +22,7 @@ import numpy as np
 
 from rtcli import kernels
 from rtcli.bvh import BVH
-from rtcli.obj import parse_obj
+from rtcli.obj import read_obj
 from rtcli.shapes.planar import barycentric, degenerate, triangle_solve
 from rtcli.vec import cross, length
 
@@ -50,13 +50,11 @@ class Mesh:
         name, smooth = p.string("file"), p.boolean("smooth", False)
         path = os.path.normpath(os.path.join(p.folder, name))
         try:
-            with open(path, encoding="utf-8", errors="replace") as f:     # OBJ is ASCII; be lenient in comments
-                text = f.read()
+            data = read_obj(path)
         except FileNotFoundError:
             raise p.error("file", f"file not found: {path}") from None
         except OSError as e:
             raise p.error("file", f"cannot read {path}: {e.strerror}") from None
-        data = parse_obj(text, path)
         try:
             return cls(data.vertices, data.faces, smooth, data.uv, data.uv_faces, data.normals, data.normal_faces)
         except ValueError as e:

@@ -18,8 +18,7 @@ which is +x for an axis along +z), v = height fraction, 0 at base, 1 at top;
 on a cap, planar: u = (x/s + 1)/2, v = (y/s + 1)/2 along (e1, e2), s the cap's
 radius, so the cap's bounding square is [0, 1]^2.
 `capped: false` leaves an open tube (no caps; its inside is visible). An open
-tube encloses no volume: its spans() are empty (no intervals), so in CSG it
-adds nothing to a union and empties an intersection.
+tube encloses no volume, so its spans() are empty and a csg refuses it as a child.
 """
 
 from __future__ import annotations
