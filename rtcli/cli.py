@@ -156,6 +156,9 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
 @click.argument("actual", metavar="ACTUAL.png")
 @click.argument("expected", metavar="EXPECTED.png")
 @click.option("--diff", metavar="DIFF.png", help="Write a heat map of the difference.")
+@click.option("--flip", "flip_out", metavar="FLIP.png",
+              help="Also write NVIDIA FLIP's perceptual error map and add its mean to the summary "
+                   "(needs flip-evaluator: pip install 'rtcli[flip]').")
 @click.option("--ids", "ids_mode", is_flag=True, help="Compare signature id maps (16-bit gray PNGs).")
 @click.option("--tolerance", type=click.IntRange(0, 255), default=2, show_default=True,
               help="A pixel is bad when a channel differs by more than this (of 255).")
@@ -167,7 +170,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
 @click.option("--max-boundary-mismatch", type=click.IntRange(0), default=8, show_default=True,
               help="--ids: mismatches allowed on id boundaries (or the fraction below, if larger).")
 @click.option("--max-boundary-fraction", type=click.FloatRange(0, 1), default=0.01, show_default=True)
-def compare(actual, expected, diff, ids_mode, tolerance, max_bad_pixels, max_bad_fraction,
+def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixels, max_bad_fraction,
             max_cluster, max_boundary_mismatch, max_boundary_fraction):
     """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it."""
     from rtcli import compare as cmp
@@ -180,9 +183,15 @@ def compare(actual, expected, diff, ids_mode, tolerance, max_bad_pixels, max_bad
         result = cmp.compare_ids(a, e, **id_options)
     else:
         result = cmp.compare(a, e, image_options, id_options)
-    if diff and a.shape == e.shape and a.ndim == 3:
+    summary = result.summary
+    comparable = a.shape == e.shape and a.ndim == 3            # pictures of the same size
+    if diff and comparable:
         write_png(diff, cmp.heat_map(a, e, tolerance))
-    click.echo(result.summary)
+    if flip_out and comparable:
+        picture, mean = cmp.flip_map(a, e)
+        write_png(flip_out, picture)
+        summary += f", mean FLIP {mean:.4f}"
+    click.echo(summary)
     if not result.ok:
         raise click.exceptions.Exit(1)
 

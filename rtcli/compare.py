@@ -202,3 +202,19 @@ def read_png(path) -> np.ndarray:
     except (OSError, ValueError, SyntaxError, EOFError, Image.DecompressionBombError) as exc:
         reason = " ".join(str(exc).split()) or type(exc).__name__
         raise RtcliError(f"{path}: not a readable PNG: {reason}") from None
+
+
+def flip_map(actual: np.ndarray, expected: np.ndarray) -> tuple[np.ndarray, float]:
+    """NVIDIA FLIP's perceptual error map (magma colors, uint8) and its mean, for two RGB images.
+
+    Needs the optional flip-evaluator package (`pip install 'rtcli[flip]'`).
+    """
+    try:
+        import flip_evaluator
+    except ImportError:
+        raise RtcliError("--flip needs the flip-evaluator package: pip install 'rtcli[flip]'") from None
+    if actual.ndim != 3 or actual.shape != expected.shape:
+        raise RtcliError("--flip compares two RGB images of the same size")
+    error, mean, _ = flip_evaluator.evaluate(expected.astype(np.float32) / 255,
+                                             actual.astype(np.float32) / 255, "LDR")
+    return np.rint(np.clip(error, 0, 1) * 255).astype(np.uint8), float(mean)

@@ -105,3 +105,20 @@ def test_compare_id_maps_without_the_ids_flag(run, tmp_path):
     assert run("compare", "a.png", "a.png").exit_code == 0
     result = run("compare", "a.png", "b.png")
     assert result.exit_code == 1 and "mismatched ids" in result.output
+
+
+def test_compare_flip_map(run, tmp_path):
+    """--flip writes FLIP's error map and adds the mean to the one summary line."""
+    pytest.importorskip("flip_evaluator")
+    a = np.full((32, 32, 3), 100, np.uint8)
+    b = a.copy()
+    b[8:16, 8:16] = 200
+    Image.fromarray(a).save(tmp_path / "a.png")
+    Image.fromarray(b).save(tmp_path / "b.png")
+    same = run("compare", "a.png", "a.png", "--flip", "f0.png")
+    assert same.exit_code == 0 and same.output.rstrip().endswith("mean FLIP 0.0000")
+    result = run("compare", "a.png", "b.png", "--flip", "f.png")
+    assert result.exit_code == 1 and result.output.count("\n") == 1
+    assert float(result.output.split("mean FLIP ")[1]) > 0.01
+    flip = np.asarray(Image.open(tmp_path / "f.png"))
+    assert flip.shape == (32, 32, 3) and flip[12, 12].sum() > flip[28, 28].sum()
