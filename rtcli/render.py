@@ -72,13 +72,17 @@ def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray) -> tuple[n
     return colors.mean(axis=0), stats
 
 
-def _tiles(job: Job):
-    """(rows, cols) index ranges of the traced grid: every pixel, or each block's top-left."""
-    b = job.block_size
+def _tiles(job: Job, samples: int = 1):
+    """(rows, cols) index ranges of the traced grid: every pixel, or each block's top-left.
+
+    With n x n samples per pixel the tile edge shrinks n-fold, so a tile is always
+    about tile^2 rays: memory does not grow with the sample count.
+    """
+    b, edge = job.block_size, max(1, job.tile // samples)
     rows, cols = np.arange(0, job.height, b), np.arange(0, job.width, b)
-    for r in range(0, len(rows), job.tile):
-        for c in range(0, len(cols), job.tile):
-            yield rows[r:r + job.tile], cols[c:c + job.tile]
+    for r in range(0, len(rows), edge):
+        for c in range(0, len(cols), edge):
+            yield rows[r:r + edge], cols[c:c + edge]
 
 
 def _run_tile(scene: Scene, job: Job, rows: np.ndarray, cols: np.ndarray):
@@ -111,7 +115,7 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     b = job.block_size
     shape = (job.height, job.width) + (() if job.signature else (3,))
     image = np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
-    stats, tiles = Stats(), list(_tiles(job))
+    stats, tiles = Stats(), list(_tiles(job, 1 if job.signature else scene.settings.samples))
     for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, job, tiles, workers), 1):
         block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
         image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]

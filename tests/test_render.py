@@ -142,3 +142,11 @@ def test_signature_is_the_same_for_any_tiling():
     a, _ = render(s, Job(9, 5, signature=True))
     b, _ = render(s, Job(9, 5, signature=True, tile=2), workers=2)
     np.testing.assert_array_equal(a, b)
+
+
+def test_tiles_shrink_with_samples_so_rays_per_tile_stay_bounded():
+    """n x n samples per pixel: tiles n times narrower, about tile^2 rays each."""
+    from rtcli.render import _tiles
+    job = Job(256, 256, tile=128)
+    assert max(len(r) * len(c) for r, c in _tiles(job, 1)) == 128 * 128
+    assert max(len(r) * len(c) for r, c in _tiles(job, 4)) * 16 == 128 * 128
