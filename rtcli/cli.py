@@ -136,6 +136,9 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     from rtcli.render import render as render_image
     from rtcli.writer import signature_colors, write_png
     scene = _load(scene_file)
+    if len(scene.objects) > 65535:
+        raise RtcliError(f"{scene_file}: {len(scene.objects)} objects, but signature ids are 16-bit "
+                         "(at most 65535 objects)")
     out = _output(scene_file, output, ".sig.png")
     if ids_out:
         _output(scene_file, ids_out)
