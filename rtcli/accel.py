@@ -80,11 +80,10 @@ class Accelerator:
         o, d = rays.origin, rays.direction
         hits = no_hits(len(rays))
         nearest_over(scene, self.unbounded, rays, t_min, hits)
+        sub = np.zeros(len(rays), dtype=np.int64)      # which face of the winning object (0 for spheres)
         if kernels.available() and self.all_spheres:
             t, member = kernels.traverse(self.bvh, o, d, t_min, hits.t, 1, *self.kernel_args)
-            sub = np.zeros(len(rays), dtype=np.int64)
         else:
-            sub = np.zeros(len(rays), dtype=np.int64)
             pairs = lambda r, m, t_max: self._pair_test(scene, o, d, t_min, r, m, t_max)
             t, member = self.bvh.intersect(o, d, t_min, hits.t, pairs, sub)
         won = member >= 0

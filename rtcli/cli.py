@@ -48,6 +48,7 @@ class RtcliGroup(click.Group):
 @click.option("--debug", is_flag=True, help="Show a traceback on errors.")
 def main(debug):
     """rtcli: a Whitted ray tracer for YAML scene files."""
+    # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
 def _load(path, bvh=True):

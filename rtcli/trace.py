@@ -35,13 +35,13 @@ def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats) -> np.ndarray:
     if depth >= scene.settings.max_depth:
         return color
     table, D = scene.materials, normalize(rays.direction)
-    kr, kt = table.kr[s.material], table.kt[s.material]
     eps = scene.offset * s.ng                            # step off the surface, to the ray's side
     mirror = np.flatnonzero(table.mirror[s.material])
     if len(mirror):
         stats.reflected += len(mirror)
         ms = reflect(D[mirror], s.n[mirror])             # ms = d - 2 (d.n) n
-        color[mirror] += kr[mirror] * trace(scene, Rays(s.p[mirror] + eps[mirror], ms), depth + 1, stats)
+        reflected = trace(scene, Rays(s.p[mirror] + eps[mirror], ms), depth + 1, stats)
+        color[mirror] += table.kr[s.material[mirror]] * reflected
     clear = np.flatnonzero(table.clear[s.material])
     if len(clear):
         ior = table.ior[s.material[clear]]
@@ -51,5 +51,5 @@ def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats) -> np.ndarray:
         stats.refracted += len(go)
         if len(go):
             rays_t = Rays(s.p[go] - eps[go], t_dir[~tir])
-            color[go] += kt[go] * trace(scene, rays_t, depth + 1, stats)
+            color[go] += table.kt[s.material[go]] * trace(scene, rays_t, depth + 1, stats)
     return color
