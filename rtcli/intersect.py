@@ -121,7 +121,8 @@ def surface(scene: Scene, rays: Rays, hits: Hits) -> Surface:
         rows = np.flatnonzero(batched)
         k = hits.obj[rows]
         q = (p[rows] - scene.accel.center[k]) / scene.accel.radius[k, None]
-        normal[rows], geometric[rows], material[rows] = q, q, scene.accel.material[k]
+        normal[rows] = geometric[rows] = normalize(q)   # as _object_surface: unit to the last bit
+        material[rows] = scene.accel.material[k]
         _texture(scene, p[rows], lambda sel: sphere_uv(q[sel]), material[rows], texture, rows)
     for k in np.flatnonzero(np.bincount(hits.obj[~batched], minlength=len(scene.objects))):
         rows = np.flatnonzero((hits.obj == k) & ~batched)
