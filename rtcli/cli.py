@@ -97,9 +97,11 @@ def _progress(enabled: bool, label: str):
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("--progress", is_flag=True, help="Show the progress bar even when stderr is not a terminal.")
 @click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")
-@click.option("--no-bvh", is_flag=True, help="Test every object against every ray (for comparisons).")
+@click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
+              help="numpy core, or compiled integrator (numba); auto: compiled for big jobs it can render.")
+@click.option("--no-bvh", is_flag=True, help="numpy engine: test every object against every ray (for comparisons).")
 def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
-           gamma, quiet, progress, stats, no_bvh):
+           gamma, quiet, progress, stats, engine, no_bvh):
     """Render SCENE.yaml to a PNG."""
     from rtcli.render import render as render_image
     from rtcli.writer import write_png
@@ -110,14 +112,16 @@ def render(scene_file, output, width, height, block_size, samples, max_depth, wo
         scene.settings.samples = samples
     if max_depth:
         scene.settings.max_depth = max_depth
-    job = _job(scene, width, height, block_size, tile=tile, gamma=gamma)
+    if no_bvh and engine == "auto":
+        engine = "numpy"                   # brute force is a numpy-engine comparison
+    job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine)
     show = _progress(not quiet and (progress or sys.stderr.isatty()), os.path.basename(scene_file))
     image, counts = render_image(scene, job, workers or os.cpu_count() or 1, show)
     write_png(out, image)
     if stats:
         seconds = time.perf_counter() - start
         click.echo(f"rays: {counts.primary} primary, {counts.shadow} shadow, {counts.reflected} reflected, "
-                   f"{counts.refracted} refracted, {counts.total} total; {seconds:.2f} s; "
+                   f"{counts.refracted} refracted, {counts.total} total; {counts.engine} engine; {seconds:.2f} s; "
                    f"{counts.total / max(seconds, 1e-9):,.0f} rays/s")
 
 

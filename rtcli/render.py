@@ -5,7 +5,8 @@ bounded by the tile size whatever the image size. Tiles go to worker processes;
 every pixel's value depends only on the pixel (jitter is hashed from its
 coordinates), so the image is the same for any tile size and worker count.
 With `block_size` B, one ray goes through the top-left pixel of each B x B block
-and the whole block gets its color (002's raytrace loop).
+and the whole block gets its color (002's raytrace loop). Job.engine picks the
+numpy core or the compiled integrator (rtcli/fast/) to trace the primary rays.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli import kernels
+from rtcli import fast, kernels
 from rtcli.intersect import find_first_hit
 from rtcli.jitter import uniform
 from rtcli.scene import Scene
@@ -38,6 +39,7 @@ class Job:
     tile: int = TILE
     signature: bool = False          # trace primary rays only and return object ids
     gamma: bool = False              # sRGB-encode when converting to 8 bits
+    engine: str = "auto"             # auto, numpy or compiled (see rtcli.fast.choose)
 
 
 def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -55,8 +57,10 @@ def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, 
     return np.array(xs), np.array(ys)
 
 
-def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, Stats]:
-    """Colors (or ids) of the pixels (i, j) of the full-size image."""
+def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
+                compiled: fast.Compiled | None = None) -> tuple[np.ndarray, Stats]:
+    """Colors (or ids) of the pixels (i, j) of the full-size image; `compiled` traces
+    them instead of the numpy core when given."""
     stats = Stats()
     cam = scene.camera(job.width, job.height)
     if job.signature:
@@ -68,7 +72,8 @@ def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray) -> tuple[n
     xs, ys = sample_positions(i, j, scene.settings.samples)
     rays = cam.rays(xs.ravel(), ys.ravel(), job.width, job.height)
     stats.primary += len(rays)
-    colors = trace(scene, rays, 1, stats).reshape(len(xs), len(i), 3)
+    colors = compiled.trace(rays, stats) if compiled else trace(scene, rays, 1, stats)
+    colors = colors.reshape(len(xs), len(i), 3)
     return colors.mean(axis=0), stats
 
 
@@ -85,25 +90,25 @@ def _tiles(job: Job, samples: int = 1):
             yield rows[r:r + edge], cols[c:c + edge]
 
 
-def _run_tile(scene: Scene, job: Job, rows: np.ndarray, cols: np.ndarray):
+def _run_tile(scene: Scene, compiled, job: Job, rows: np.ndarray, cols: np.ndarray):
     """A tile's 8-bit pixels (or ids), small enough to pile up while the parent catches up."""
     jj, ii = np.meshgrid(rows, cols, indexing="ij")
-    values, stats = render_tile(scene, job, ii.ravel(), jj.ravel())
+    values, stats = render_tile(scene, job, ii.ravel(), jj.ravel(), compiled)
     if not job.signature:
         values = to_8bit(values, job.gamma)
     return rows, cols, values.reshape(len(rows), len(cols), *values.shape[1:]), stats
 
 
-_worker_scene = None                       # the scene, sent once to each worker process
+_worker_scene = (None, None)               # the scene and its compiled form, sent once to each worker
 
 
-def _init_worker(scene: Scene) -> None:
+def _init_worker(scene: Scene, compiled) -> None:
     global _worker_scene
-    _worker_scene = scene
+    _worker_scene = (scene, compiled)
 
 
 def _worker_tile(job: Job, rows, cols):
-    return _run_tile(_worker_scene, job, rows, cols)
+    return _run_tile(*_worker_scene, job, rows, cols)
 
 
 def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.ndarray, Stats]:
@@ -116,7 +121,10 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     shape = (job.height, job.width) + (() if job.signature else (3,))
     image = np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
     stats, tiles = Stats(), list(_tiles(job, 1 if job.signature else scene.settings.samples))
-    for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, job, tiles, workers), 1):
+    traced = sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
+    compiled = None if job.signature else fast.choose(scene, job.engine, traced)
+    stats.engine = "compiled" if compiled else "numpy"          # add() keeps it
+    for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, compiled, job, tiles, workers), 1):
         block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
         image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
         stats.add(s)
@@ -132,16 +140,18 @@ def _uses_kernels(scene: Scene) -> bool:
             or (scene.accel is not None and scene.accel.all_spheres))
 
 
-def _map_tiles(scene: Scene, job: Job, tiles: list, workers: int):
+def _map_tiles(scene: Scene, compiled, job: Job, tiles: list, workers: int):
     if workers <= 1 or len(tiles) == 1:
         for rows, cols in tiles:
-            yield _run_tile(scene, job, rows, cols)
+            yield _run_tile(scene, compiled, job, rows, cols)
         return
-    if _uses_kernels(scene):
-        kernels.warm_up()                  # loaded once here, not once per worker
+    if compiled:
+        compiled.warm_up()                 # loaded once here, not once per worker
+    elif _uses_kernels(scene):
+        kernels.warm_up()
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
-                             initargs=(scene,)) as pool:
+                             initargs=(scene, compiled)) as pool:
         futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
         for f in as_completed(futures):
             yield f.result()

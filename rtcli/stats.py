@@ -11,10 +11,12 @@ class Stats:
     shadow: int = 0
     reflected: int = 0
     refracted: int = 0
+    engine: str = ""                 # which engine traced them: "numpy" or "compiled"
 
     def add(self, other: "Stats") -> None:
         for f in fields(self):
-            setattr(self, f.name, getattr(self, f.name) + getattr(other, f.name))
+            if f.name != "engine":
+                setattr(self, f.name, getattr(self, f.name) + getattr(other, f.name))
 
     @property
     def total(self) -> int:

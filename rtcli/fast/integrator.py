@@ -1,0 +1,178 @@
+"""rayTrace() of notes 000 11.7 compiled per ray (numba): the fast path for the scenes pack.py accepts.
+
+The numpy core (trace.py, shade.py, intersect.py) is the reference; this is the
+same integrator written for one ray, so no array is built per bounce:
+
+    radiance(ray) = background                                   on a miss
+                  = local(p) + kr radiance(mirror ray) + kt radiance(refracted ray)
+
+with the local term of shade.py (emission + ka Ia T + per light not in shadow
+with N.L > 0: att(r) I (kd T (N.L) + ks spec)). Every sum and product is taken
+in the numpy code's order, so both paths give the same pixels.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rtcli.fast.pack import KIND, MESH, NRM, XF
+from rtcli.fast.query import object_ray, scene_hit
+from rtcli.fast.shapes import apply, entry, inline, jit, normal
+
+SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
+
+
+@inline
+def surface(g, k, prim, t, ox, oy, oz, dx, dy, dz):
+    """The unit outward normal at the hit and the object-space hit point (intersect.surface)."""
+    row, kind, transformed = g.objects[k], g.ints[k, KIND], g.ints[k, XF]
+    qx, qy, qz, ex, ey, ez = object_ray(row, transformed, ox, oy, oz, dx, dy, dz)
+    px, py, pz = qx + t * ex, qy + t * ey, qz + t * ez
+    if kind == MESH:
+        nx, ny, nz = g.tris[prim, 9], g.tris[prim, 10], g.tris[prim, 11]
+    else:
+        nx, ny, nz = normal(kind, row, px, py, pz, prim)
+    if transformed:
+        nx, ny, nz = apply(row, NRM, nx, ny, nz, 0)
+    length = math.sqrt(nx * nx + ny * ny + nz * nz)
+    return nx / length, ny / length, nz / length, px, py, pz
+
+
+@inline
+def texture(s, m, px, py, pz):
+    """T at the object-space point: 1 without a texture, else the checker's color (textures.Checker)."""
+    c = s.checker[m]
+    if c[0] == 0:
+        return 1.0, 1.0, 1.0
+    cells = np.floor(px * c[1] + 1e-6) + np.floor(py * c[1] + 1e-6) + np.floor(pz * c[1] + 1e-6)
+    j = 2 if cells % 2.0 == 0 else 5                                # an integer, as a float: even or odd
+    return c[j], c[j + 1], c[j + 2]
+
+
+@inline
+def local(g, s, m, T, px, py, pz, nx, ny, nz, Vx, Vy, Vz, counts, stack):
+    """shade.local for one hit: emission, ambient and the lights that see it."""
+    cr = s.emission[m, 0] + s.ka[m, 0] * s.ambient[0] * T[0]
+    cg = s.emission[m, 1] + s.ka[m, 1] * s.ambient[1] * T[1]
+    cb = s.emission[m, 2] + s.ka[m, 2] * s.ambient[2] * T[2]
+    NV = nx * Vx + ny * Vy + nz * Vz
+    eps = s.offset
+    sx, sy, sz = px + eps * nx, py + eps * ny, pz + eps * nz          # feelers leave from the lit side
+    for li in range(len(s.lights)):
+        light = s.lights[li]
+        lx, ly, lz = light[0] - px, light[1] - py, light[2] - pz
+        r = math.sqrt(lx * lx + ly * ly + lz * lz)
+        Lx, Ly, Lz = lx / r, ly / r, lz / r
+        NL = nx * Lx + ny * Ly + nz * Lz
+        if not NL > 0:                                                # no contribution (004, case 2)
+            continue
+        counts[SHADOW] += 1
+        if scene_hit(g, sx, sy, sz, light[0] - sx, light[1] - sy, light[2] - sz, 0.0, 1.0, True, stack)[1] >= 0:
+            continue
+        spot = 1.0
+        if light[14] != 0:
+            cos = -(Lx * light[9] + Ly * light[10] + Lz * light[11])
+            spot = max(cos, 0.0) ** light[13] if cos >= light[12] else 0.0
+        weight = 1.0 / (light[6] + light[7] * r + light[8] * r * r) * spot / 1
+        wNL = weight * NL
+        cr += wNL * light[3] * (s.kd[m, 0] * T[0])
+        cg += wNL * light[4] * (s.kd[m, 1] * T[1])
+        cb += wNL * light[5] * (s.kd[m, 2] * T[2])
+        if s.shiny[m]:
+            if s.blinn:
+                Hx, Hy, Hz = Lx + Vx, Ly + Vy, Lz + Vz
+                cos = (nx * Hx + ny * Hy + nz * Hz) / math.sqrt(Hx * Hx + Hy * Hy + Hz * Hz)
+            else:
+                cos = 2 * NL * NV - (Lx * Vx + Ly * Vy + Lz * Vz)
+            w = weight * max(cos, 0.0) ** s.shininess[m]
+            cr += w * light[3] * s.ks[m, 0]
+            cg += w * light[4] * s.ks[m, 1]
+            cb += w * light[5] * s.ks[m, 2]
+    return cr, cg, cb
+
+
+@inline
+def shade_local(g, s, ray, f, counts, stack):
+    """First hit and local term of one ray: (hit?, color); on a hit, f holds the frame of
+    the secondary rays: color, p, facing n, unit D, entering, material, stage 0."""
+    ox, oy, oz, dx, dy, dz = ray
+    t, k, prim = scene_hit(g, ox, oy, oz, dx, dy, dz, 0.0, np.inf, False, stack)
+    if k < 0:
+        return False, s.background[0], s.background[1], s.background[2]
+    px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
+    nx, ny, nz, qx, qy, qz = surface(g, k, prim, t, ox, oy, oz, dx, dy, dz)
+    entering = dx * nx + dy * ny + dz * nz < 0
+    if not entering:                                                  # face the incoming ray
+        nx, ny, nz = -nx, -ny, -nz
+    m = s.material[k]
+    length = math.sqrt(dx * dx + dy * dy + dz * dz)
+    Dx, Dy, Dz = dx / length, dy / length, dz / length
+    cr, cg, cb = local(g, s, m, texture(s, m, qx, qy, qz), px, py, pz, nx, ny, nz, -Dx, -Dy, -Dz, counts, stack)
+    f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8] = cr, cg, cb, px, py, pz, nx, ny, nz
+    f[9], f[10], f[11], f[12], f[13], f[14] = Dx, Dy, Dz, 1.0 if entering else 0.0, m, 0
+    return True, cr, cg, cb
+
+
+@inline
+def next_ray(s, f, counts):
+    """The frame's next secondary ray (trace.shade): the mirror ray at stage 0, the refracted
+    ray at stage 1 (none past the critical angle); (False, _) when none is left."""
+    m = int(f[13])
+    px, py, pz, nx, ny, nz, Dx, Dy, Dz = f[3], f[4], f[5], f[6], f[7], f[8], f[9], f[10], f[11]
+    ex, ey, ez = s.offset * nx, s.offset * ny, s.offset * nz          # step off the surface
+    if f[14] == 0:
+        f[14] = 1
+        if s.mirror[m]:
+            counts[REFLECTED] += 1
+            dn = 2 * (Dx * nx + Dy * ny + Dz * nz)                    # ms = d - 2 (d.n) n
+            return True, (px + ex, py + ey, pz + ez, Dx - dn * nx, Dy - dn * ny, Dz - dn * nz)
+    if f[14] == 1:
+        f[14] = 2
+        if s.clear[m]:
+            ior = s.ior[m]
+            eta = 1.0 / ior if f[12] else ior                         # 1 -> ior entering, ior -> 1 leaving
+            cos_i = -(Dx * nx + Dy * ny + Dz * nz)
+            kk = 1 - eta * eta * (1 - cos_i * cos_i)
+            if kk >= 0:                                               # else total internal reflection
+                counts[REFRACTED] += 1
+                b = eta * cos_i - math.sqrt(max(kk, 0.0))
+                tx, ty, tz = eta * Dx + b * nx, eta * Dy + b * ny, eta * Dz + b * nz
+                tl = math.sqrt(tx * tx + ty * ty + tz * tz)
+                return True, (px - ex, py - ey, pz - ez, tx / tl, ty / tl, tz / tl)
+    return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@jit
+def radiance(g, s, ray, counts, frames, stack):
+    """The color seen along one primary ray: local + kr radiance(mirror) + kt radiance(refracted),
+    depth first with frames[L] the pending hit at depth L + 1 instead of recursion."""
+    L = 0
+    while True:
+        found, cr, cg, cb = shade_local(g, s, ray, frames[L], counts, stack)
+        more = False
+        if found and L + 1 < s.max_depth:
+            more, ray = next_ray(s, frames[L], counts)
+        while not more and L > 0:                                     # hand the color to the parent
+            L -= 1
+            f, m = frames[L], int(frames[L, 13])
+            k = s.kr[m] if f[14] == 1 else s.kt[m]
+            f[0], f[1], f[2] = f[0] + k[0] * cr, f[1] + k[1] * cg, f[2] + k[2] * cb
+            more, ray = next_ray(s, f, counts)
+            cr, cg, cb = f[0], f[1], f[2]
+        if not more:
+            return cr, cg, cb
+        L += 1
+
+
+@entry
+def trace_rays(g, s, origin, direction, counts, stack):
+    """(n, 3) colors of the primary rays (origin, direction) (n, 3)."""
+    n = len(origin)
+    out = np.empty((n, 3))
+    frames = np.empty((max(s.max_depth, 1), 16))
+    for i in range(n):
+        ray = (origin[i, 0], origin[i, 1], origin[i, 2], direction[i, 0], direction[i, 1], direction[i, 2])
+        out[i] = radiance(g, s, ray, counts, frames, stack)
+    return out

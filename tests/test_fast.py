@@ -1,0 +1,153 @@
+"""The compiled engine (rtcli/fast/) against its oracle, the numpy core: the same pixels, the same ray counts.
+
+The first test to run compiles the integrator (about 30 s) unless numba's cache has it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rtcli import fast, kernels
+from rtcli.build import load_scene
+from rtcli.errors import RtcliError
+from rtcli.render import Job, render, render_tile
+
+pytestmark = pytest.mark.skipif(not kernels.ENABLED, reason="numba is not installed")
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENES = sorted((ROOT / "scenes").glob("*.yaml")) + sorted((ROOT / "bench").glob("*.yaml"))
+SUPPORTED = [p for p in SCENES if fast.unsupported(load_scene(str(p))) is None]
+
+
+def both(scene, width=96, height=72, **job):
+    """(numpy image, compiled image, numpy stats, compiled stats) of one scene."""
+    a, sa = render(scene, Job(width, height, engine="numpy", **job))
+    b, sb = render(scene, Job(width, height, engine="compiled", **job))
+    return a, b, sa, sb
+
+
+def test_the_supported_scenes_cover_every_compiled_shape():
+    kinds = {type(o.shape).__name__ for p in SUPPORTED for o in load_scene(str(p)).objects}
+    assert {"Sphere", "Plane", "Box", "Cylinder", "Cone", "Mesh"} <= kinds
+    assert len(SUPPORTED) >= 9
+
+
+@pytest.mark.parametrize("path", SUPPORTED, ids=lambda p: f"{p.parent.name}/{p.stem}")
+def test_every_supported_scene_renders_the_same_pixels_and_rays(path):
+    scene = load_scene(str(path))
+    a, b, sa, sb = both(scene)
+    assert np.array_equal(a, b), f"{np.count_nonzero((a != b).any(axis=2))} pixels differ"
+    assert (sa.primary, sa.shadow, sa.reflected, sa.refracted) == (sb.primary, sb.shadow, sb.reflected, sb.refracted)
+    assert (sa.engine, sb.engine) == ("numpy", "compiled")
+
+
+def test_colors_are_equal_to_the_last_bit(yaml_scene):
+    """Before rounding to bytes: every sum and product is taken in the numpy core's order."""
+    scene = load_scene(str(ROOT / "bench" / "quadrics.yaml"))
+    i, j = np.meshgrid(np.arange(0, 640, 7), np.arange(0, 480, 5))
+    job = Job(640, 480)
+    a, _ = render_tile(scene, job, i.ravel(), j.ravel())
+    b, _ = render_tile(scene, job, i.ravel(), j.ravel(), fast.choose(scene, "compiled"))
+    assert np.array_equal(a, b)
+
+
+TRANSFORMED = """
+camera: {eye: [0, 3, -9], look_at: [0, 0.5, 0], fov: 45}
+ambient: [0.2, 0.2, 0.2]
+render: {max_depth: 6, specular: SPEC}
+lights:
+  - {position: [4, 6, -5], color: [0.9, 0.9, 0.9], attenuation: [1, 0.02, 0.001]}
+  - {position: [-3, 5, -2], color: [0.6, 0.5, 0.4], spot: {direction: [0.6, -1, 0.4], angle: 30, falloff: 4}}
+materials:
+  glass: {diffuse: 0.05, specular: 0.8, shininess: 50, reflection: 0.1, transmission: 0.85, ior: 1.45}
+  mirror: {diffuse: 0.1, specular: 0.5, reflection: 0.7}
+  checks: {texture: {checker: {colors: [[1, 1, 1], [0.1, 0.2, 0.6]], size: 0.5}}, emission: [0.05, 0, 0]}
+objects:
+  - {plane: {normal: [0.1, 1, 0], point: [0, -1, 0]}, material: checks}
+  - {sphere: {}, material: glass, transform: [{scale: [1.2, 0.6, 0.9]}, {rotate: {axis: [1, 1, 0], degrees: 35}}, {translate: [-1.5, 0.4, 0]}]}
+  - {box: {min: [-1, -0.5, -0.3], max: [0.6, 0.5, 0.8]}, material: mirror, transform: [{rotate: {axis: [0, 1, 0], degrees: 25}}, {scale: [-1, 1, 1]}, {translate: [1.8, 0, 1]}]}
+  - {cylinder: {base: [0, -1, 0], top: [0.3, 1.2, 0.2], radius: 0.4}, material: checks, transform: [{translate: [0, 0, 2]}]}
+  - {cone: {base: [0, 0, 0], top: [0, 1, 0], radius: 0.6, top_radius: 0.25}, material: glass, transform: [{scale: [1, 1.5, 1]}, {translate: [0.5, -0.9, -1.5]}]}
+  - {cone: {radius: 0.5, capped: false}, transform: [{rotate: {axis: [1, 0, 0], degrees: -70}}, {translate: [-2.5, 1, 1.5]}]}
+  - {box: {}, material: {diffuse: [0.8, 0.3, 0.2], shadow: false}, transform: [{scale: 0.3}, {translate: [0, 1.6, 0]}]}
+"""
+
+
+@pytest.mark.parametrize("spec", ["phong", "blinn"])
+def test_transformed_quadrics_glass_spots_and_attenuation(yaml_scene, spec):
+    scene = yaml_scene(TRANSFORMED.replace("SPEC", spec))
+    a, b, sa, sb = both(scene, 120, 90)
+    assert np.array_equal(a, b)
+    assert sb.refracted > 0 and sb.reflected > 0 and sb.shadow > 0
+    assert len(np.unique(b.reshape(-1, 3), axis=0)) > 1000          # a real picture, not a flat fill
+
+
+def test_samples_max_depth_block_size_and_workers(yaml_scene):
+    scene = yaml_scene(TRANSFORMED.replace("SPEC", "phong"))
+    scene.settings.samples, scene.settings.max_depth = 2, 3
+    a, b, _, _ = both(scene, 64, 48, block_size=2)
+    assert np.array_equal(a, b)
+    c, _ = render(scene, Job(64, 48, block_size=2, tile=16, engine="compiled"), workers=2)
+    assert np.array_equal(b, c)
+
+
+def test_many_objects_go_through_the_scene_bvh(yaml_scene):
+    rng = np.random.default_rng(5)
+    balls = "\n".join(f"  - {{sphere: {{center: [{x:.3f}, {y:.3f}, {z:.3f}], radius: {r:.3f}}}, "
+                      f"material: {{diffuse: [{x % 1:.2f}, 0.5, 0.5], reflection: {0.4 if k % 3 == 0 else 0}}}}}"
+                      for k, (x, y, z, r) in enumerate(zip(*rng.uniform(-3, 3, (3, 60)), rng.uniform(0.1, 0.5, 60))))
+    scene = yaml_scene(f"""
+        camera: {{eye: [0, 0, -12], look_at: [0, 0, 0], fov: 40}}
+        lights: [{{position: [5, 8, -8], color: [1, 1, 1]}}]
+        objects:
+        {balls}
+        """.replace("\n        ", "\n"))
+    assert fast.Compiled(scene).geometry.links.shape[0] > 1
+    a, b, _, _ = both(scene, 80, 80)
+    assert np.array_equal(a, b)
+
+
+def test_unsupported_names_what_the_compiled_engine_lacks():
+    reasons = {p.stem: fast.unsupported(load_scene(str(p))) for p in SCENES}
+    assert reasons["csg"] == "csg objects"
+    assert reasons["torus"] == "torus objects"
+    assert reasons["lights"] == "area lights"
+    assert reasons["teapot"] == "smooth meshes"
+    assert reasons["whitted"] is None
+
+
+def test_choose_falls_back_to_numpy_or_says_why(monkeypatch):
+    csg = load_scene(str(ROOT / "scenes" / "csg.yaml"))
+    whitted = load_scene(str(ROOT / "scenes" / "whitted.yaml"))
+    assert fast.choose(csg, "auto") is None
+    with pytest.raises(RtcliError, match="cannot render this scene: it does not handle csg objects"):
+        fast.choose(csg, "compiled")
+    assert fast.choose(whitted, "numpy") is None
+    assert fast.choose(whitted, "auto", rays=fast.AUTO_RAYS - 1) is None     # small jobs: no numba start-up
+    assert isinstance(fast.choose(whitted, "auto"), fast.Compiled)
+    monkeypatch.setattr(kernels, "ENABLED", False)
+    assert fast.choose(whitted, "auto") is None
+    with pytest.raises(RtcliError, match="numba is not installed"):
+        fast.choose(whitted, "compiled")
+
+
+def test_a_source_change_drops_the_cached_machine_code(tmp_path, monkeypatch):
+    """numba alone would keep machine code built from an older shapes.py inside integrator's cache."""
+    package = tmp_path / "fast"
+    (package / "__pycache__").mkdir(parents=True)
+    for name in ("pack.py", "shapes.py", "query.py", "integrator.py"):
+        (package / name).write_text(f"# {name}\n")
+    stale = package / "__pycache__" / "integrator.trace_rays-1.py311.nbi"
+    stale.write_text("old")
+    monkeypatch.setattr(fast, "__file__", str(package / "__init__.py"))
+    fast._drop_stale_cache()
+    assert not stale.exists()
+    stale.write_text("new")
+    fast._drop_stale_cache()                      # same sources: the cache stays
+    assert stale.exists()
+    (package / "shapes.py").write_text("# changed\n")
+    fast._drop_stale_cache()
+    assert not stale.exists()
