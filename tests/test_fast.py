@@ -31,8 +31,10 @@ def both(scene, width=96, height=72, **job):
 
 def test_the_supported_scenes_cover_every_compiled_shape():
     kinds = {type(o.shape).__name__ for p in SUPPORTED for o in load_scene(str(p)).objects}
-    assert {"Sphere", "Plane", "Box", "Cylinder", "Cone", "Mesh"} <= kinds
-    assert len(SUPPORTED) >= 9
+    assert {"Sphere", "Plane", "Box", "Cylinder", "Cone", "Mesh", "Triangle", "Polygon"} <= kinds
+    assert any(o.shape.normal_corners is not None for p in SUPPORTED for o in load_scene(str(p)).objects
+               if type(o.shape).__name__ == "Mesh")
+    assert len(SUPPORTED) >= 17
 
 
 @pytest.mark.parametrize("path", SUPPORTED, ids=lambda p: f"{p.parent.name}/{p.stem}")
@@ -73,12 +75,22 @@ objects:
   - {cone: {base: [0, 0, 0], top: [0, 1, 0], radius: 0.6, top_radius: 0.25}, material: glass, transform: [{scale: [1, 1.5, 1]}, {translate: [0.5, -0.9, -1.5]}]}
   - {cone: {radius: 0.5, capped: false}, transform: [{rotate: {axis: [1, 0, 0], degrees: -70}}, {translate: [-2.5, 1, 1.5]}]}
   - {box: {}, material: {diffuse: [0.8, 0.3, 0.2], shadow: false}, transform: [{scale: 0.3}, {translate: [0, 1.6, 0]}]}
+  - {square: {}, material: mirror, transform: [{scale: 0.8}, {rotate: {axis: [0, 1, 0], degrees: 200}}, {translate: [-1, 0.5, 3]}]}
+  - triangle:
+      vertices: [[2, -1, 2.5], [3.5, -1, 3], [2.8, 1.5, 2.8]]
+      normals: [[-1, 0.2, -1], [1, 0.3, -1], [0, 1, -0.5]]
+    material: glass
+  - {polygon: {vertices: [[-3, -1, 3], [-1.5, -1, 3], [-2.2, 0, 3], [-1.5, 1, 3], [-3, 1, 3]]}, material: checks}
 """
 
 
 @pytest.mark.parametrize("spec", ["phong", "blinn"])
-def test_transformed_quadrics_glass_spots_and_attenuation(yaml_scene, spec):
+def test_transformed_shapes_glass_spots_and_attenuation(yaml_scene, spec):
+    """Every kind of shape the compiled engine has, most under transforms (a mirror one too),
+    a smooth glass triangle and a concave polygon."""
     scene = yaml_scene(TRANSFORMED.replace("SPEC", spec))
+    ids, _ = render(scene, Job(120, 90, signature=True))
+    assert set(range(1, len(scene.objects) + 1)) <= set(np.unique(ids).tolist())    # each one in view
     a, b, sa, sb = both(scene, 120, 90)
     assert np.array_equal(a, b)
     assert sb.refracted > 0 and sb.reflected > 0 and sb.shadow > 0
@@ -115,7 +127,7 @@ def test_unsupported_names_what_the_compiled_engine_lacks():
     assert reasons["csg"] == "csg objects"
     assert reasons["torus"] == "torus objects"
     assert reasons["lights"] == "area lights"
-    assert reasons["teapot"] == "smooth meshes"
+    assert reasons["spot"] == "image textures"
     assert reasons["whitted"] is None
 
 

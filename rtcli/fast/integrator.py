@@ -17,27 +17,37 @@ import math
 
 import numpy as np
 
-from rtcli.fast.pack import KIND, MESH, NRM, XF
+from rtcli.fast.pack import KIND, MESH, NRM, SMOOTH, TRIANGLE, XF
 from rtcli.fast.query import object_ray, scene_hit
-from rtcli.fast.shapes import apply, entry, inline, jit, normal
+from rtcli.fast.shapes import apply, entry, inline, interpolated, jit, normal
 
 SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
 
 
 @inline
 def surface(g, k, prim, t, ox, oy, oz, dx, dy, dz):
-    """The unit outward normal at the hit and the object-space hit point (intersect.surface)."""
+    """Unit outward shading and geometric normals at the hit, and the object-space hit point
+    (intersect.surface: smooth triangles interpolate their corner normals)."""
     row, kind, transformed = g.objects[k], g.ints[k, KIND], g.ints[k, XF]
     qx, qy, qz, ex, ey, ez = object_ray(row, transformed, ox, oy, oz, dx, dy, dz)
     px, py, pz = qx + t * ex, qy + t * ey, qz + t * ez
+    tri, smooth = row, False
     if kind == MESH:
-        nx, ny, nz = g.tris[prim, 9], g.tris[prim, 10], g.tris[prim, 11]
+        tri, smooth = g.pool[prim], g.ints[k, SMOOTH] != 0
+        gx, gy, gz = tri[9], tri[10], tri[11]
     else:
-        nx, ny, nz = normal(kind, row, px, py, pz, prim)
+        smooth = kind == TRIANGLE and row[21] != 0
+        gx, gy, gz = normal(kind, row, px, py, pz, prim)
+    nx, ny, nz = gx, gy, gz
+    if smooth:
+        nx, ny, nz = interpolated(tri, px, py, pz)
+        if kind == MESH and not math.sqrt(nx * nx + ny * ny + nz * nz) > 0:
+            nx, ny, nz = gx, gy, gz                                   # no corner normals: the face's
     if transformed:
         nx, ny, nz = apply(row, NRM, nx, ny, nz, 0)
-    length = math.sqrt(nx * nx + ny * ny + nz * nz)
-    return nx / length, ny / length, nz / length, px, py, pz
+        gx, gy, gz = apply(row, NRM, gx, gy, gz, 0)
+    length, glength = math.sqrt(nx * nx + ny * ny + nz * nz), math.sqrt(gx * gx + gy * gy + gz * gz)
+    return nx / length, ny / length, nz / length, gx / glength, gy / glength, gz / glength, px, py, pz
 
 
 @inline
@@ -52,14 +62,14 @@ def texture(s, m, px, py, pz):
 
 
 @inline
-def local(g, s, m, T, px, py, pz, nx, ny, nz, Vx, Vy, Vz, counts, stack):
+def local(g, s, m, T, px, py, pz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, counts, stack):
     """shade.local for one hit: emission, ambient and the lights that see it."""
     cr = s.emission[m, 0] + s.ka[m, 0] * s.ambient[0] * T[0]
     cg = s.emission[m, 1] + s.ka[m, 1] * s.ambient[1] * T[1]
     cb = s.emission[m, 2] + s.ka[m, 2] * s.ambient[2] * T[2]
     NV = nx * Vx + ny * Vy + nz * Vz
     eps = s.offset
-    sx, sy, sz = px + eps * nx, py + eps * ny, pz + eps * nz          # feelers leave from the lit side
+    sx, sy, sz = px + eps * gx, py + eps * gy, pz + eps * gz          # feelers leave from the lit side
     for li in range(len(s.lights)):
         light = s.lights[li]
         lx, ly, lz = light[0] - px, light[1] - py, light[2] - pz
@@ -95,23 +105,27 @@ def local(g, s, m, T, px, py, pz, nx, ny, nz, Vx, Vy, Vz, counts, stack):
 
 @inline
 def shade_local(g, s, ray, f, counts, stack):
-    """First hit and local term of one ray: (hit?, color); on a hit, f holds the frame of
-    the secondary rays: color, p, facing n, unit D, entering, material, stage 0."""
+    """First hit and local term of one ray: (hit?, color); on a hit, f holds the frame of the
+    secondary rays: color, p, facing n, unit D, entering, material, stage 0, facing geometric n."""
     ox, oy, oz, dx, dy, dz = ray
     t, k, prim = scene_hit(g, ox, oy, oz, dx, dy, dz, 0.0, np.inf, False, stack)
     if k < 0:
         return False, s.background[0], s.background[1], s.background[2]
     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
-    nx, ny, nz, qx, qy, qz = surface(g, k, prim, t, ox, oy, oz, dx, dy, dz)
-    entering = dx * nx + dy * ny + dz * nz < 0
+    nx, ny, nz, gx, gy, gz, qx, qy, qz = surface(g, k, prim, t, ox, oy, oz, dx, dy, dz)
+    entering = dx * gx + dy * gy + dz * gz < 0
     if not entering:                                                  # face the incoming ray
-        nx, ny, nz = -nx, -ny, -nz
+        nx, ny, nz, gx, gy, gz = -nx, -ny, -nz, -gx, -gy, -gz
+    if dx * nx + dy * ny + dz * nz > 0:                               # a shading normal turned away
+        nx, ny, nz = gx, gy, gz
     m = s.material[k]
     length = math.sqrt(dx * dx + dy * dy + dz * dz)
     Dx, Dy, Dz = dx / length, dy / length, dz / length
-    cr, cg, cb = local(g, s, m, texture(s, m, qx, qy, qz), px, py, pz, nx, ny, nz, -Dx, -Dy, -Dz, counts, stack)
+    cr, cg, cb = local(g, s, m, texture(s, m, qx, qy, qz), px, py, pz, nx, ny, nz, gx, gy, gz, -Dx, -Dy, -Dz,
+                       counts, stack)
     f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8] = cr, cg, cb, px, py, pz, nx, ny, nz
     f[9], f[10], f[11], f[12], f[13], f[14] = Dx, Dy, Dz, 1.0 if entering else 0.0, m, 0
+    f[15], f[16], f[17] = gx, gy, gz
     return True, cr, cg, cb
 
 
@@ -121,7 +135,7 @@ def next_ray(s, f, counts):
     ray at stage 1 (none past the critical angle); (False, _) when none is left."""
     m = int(f[13])
     px, py, pz, nx, ny, nz, Dx, Dy, Dz = f[3], f[4], f[5], f[6], f[7], f[8], f[9], f[10], f[11]
-    ex, ey, ez = s.offset * nx, s.offset * ny, s.offset * nz          # step off the surface
+    ex, ey, ez = s.offset * f[15], s.offset * f[16], s.offset * f[17]  # step off the surface
     if f[14] == 0:
         f[14] = 1
         if s.mirror[m]:
@@ -171,7 +185,7 @@ def trace_rays(g, s, origin, direction, counts, stack):
     """(n, 3) colors of the primary rays (origin, direction) (n, 3)."""
     n = len(origin)
     out = np.empty((n, 3))
-    frames = np.empty((max(s.max_depth, 1), 16))
+    frames = np.empty((max(s.max_depth, 1), 18))
     for i in range(n):
         ray = (origin[i, 0], origin[i, 1], origin[i, 2], direction[i, 0], direction[i, 1], direction[i, 2])
         out[i] = radiance(g, s, ray, counts, frames, stack)

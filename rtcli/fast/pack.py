@@ -1,15 +1,15 @@
 """A Scene as flat arrays for the compiled path, or the reason it cannot be.
 
 The compiled integrator handles the shapes most scenes are made of: spheres,
-planes, boxes, cylinders, cones and triangle meshes, each with any transform;
-materials with no texture or a checker; point and spot lights. Anything else
-(CSG, torus, single triangles, polygons, squares, image textures, area lights)
-keeps the numpy path: `unsupported(scene)` names the first such thing.
+planes, boxes, cylinders, cones, triangles, squares, polygons and triangle
+meshes (flat or smooth), each with any transform; materials with no texture or
+a checker; point and spot lights. Anything else (CSG, torus, image textures,
+area lights) keeps the numpy path: `unsupported(scene)` names the first such thing.
 
 Geometry (`Geometry`): one row per scene object (see shapes.py for the row
 layout), the unbounded objects (planes) by index, and a BVH over the bounded
-ones. Meshes put their triangles and BVH nodes in shared arrays; a mesh row's
-par holds its root node. Looks (`Looks`): the MaterialTable's arrays, the
+ones. Meshes put their triangles and BVH nodes in shared arrays, polygons their
+vertices; an object's integers say where its own start. Looks (`Looks`): the MaterialTable's arrays, the
 checker of each material, the lights and the scene constants.
 """
 
@@ -22,17 +22,19 @@ import numpy as np
 from rtcli.bvh import BVH
 from rtcli.shapes.box import Box
 from rtcli.shapes.mesh import Mesh
-from rtcli.shapes.planar import Plane
+from rtcli.shapes.planar import Plane, Polygon, Square, Triangle
 from rtcli.shapes.quadric import _Tapered
 from rtcli.shapes.sphere import Sphere
 from rtcli.textures import Checker
 
-SPHERE, PLANE, BOX, TAPERED, MESH = range(5)        # shape kinds, as in shapes.py
-INV, NRM, WIDTH = 20, 32, 44                        # columns of an object row: parameters, object_from_world, A^-T
-KIND, XF, CASTS, ROOT = range(4)                    # columns of an object's integers
+SPHERE, PLANE, BOX, TAPERED, TRIANGLE, SQUARE, MESH, POLYGON = range(8)    # shape kinds, as in shapes.py
+INV, NRM, WIDTH = 24, 36, 48                        # columns of an object row: parameters, object_from_world, A^-T
+KIND, XF, CASTS, ROOT, SMOOTH = range(5)            # columns of an object's integers
+POOL = 21                                           # pool rows: a triangle's a, e1, e2, face, corner normals
 
 # Few arrays on purpose: numba passes each array as ~8 machine words per call.
-Geometry = namedtuple("Geometry", "objects ints unbounded nodes links perm tris")
+# pool: the triangles of every mesh, then the vertices of every polygon (x, y, z in a row).
+Geometry = namedtuple("Geometry", "objects ints unbounded nodes links perm pool")
 Looks = namedtuple("Looks", "material ka kd ks emission kr kt shininess ior shiny mirror clear "
                             "checker lights ambient background offset max_depth blinn")
 
@@ -40,10 +42,8 @@ Looks = namedtuple("Looks", "material ka kd ks emission kr kt shininess ior shin
 def unsupported(scene) -> str | None:
     """Why the compiled path cannot render `scene`, or None when it can."""
     for o in scene.objects:
-        if not isinstance(o.shape, (Sphere, Plane, Box, _Tapered, Mesh)):
+        if not isinstance(o.shape, (Sphere, Plane, Box, _Tapered, Mesh, Triangle, Square, Polygon)):
             return f"{o.kind or type(o.shape).__name__} objects"
-        if isinstance(o.shape, Mesh) and o.shape.normal_corners is not None:
-            return "smooth meshes"
     for m in scene.materials.materials:
         if m.texture is not None and not isinstance(m.texture, Checker):
             return "image textures"
@@ -61,6 +61,12 @@ def _row(shape) -> tuple[int, list]:
         return PLANE, [*shape.point, *shape.n]
     if isinstance(shape, Box):
         return BOX, [*shape.lo, *shape.hi]
+    if isinstance(shape, Square):
+        return SQUARE, []
+    if isinstance(shape, Triangle):
+        smooth = shape.normals is not None
+        corners = shape.normals.ravel() if smooth else np.zeros(9)
+        return TRIANGLE, [*shape.a, *shape.e1, *shape.e2, *shape.face, *corners, float(smooth)]
     s = shape
     return TAPERED, [*s.base, *s.e1, *s.e2, *s.a, s.r, s.h, s.s0, s.s1, float(s.capped)]
 
@@ -96,22 +102,32 @@ class _Trees:
 def geometry(scene) -> tuple[Geometry, int]:
     """The scene's geometry, and the traversal stack size it needs (scene tree, then a mesh's)."""
     n = len(scene.objects)
-    objects, ints = np.zeros((n, WIDTH)), np.zeros((n, 4), dtype=np.int64)
+    objects, ints = np.zeros((n, WIDTH)), np.zeros((n, 5), dtype=np.int64)
     boxes = scene.boxes
     members = np.array([k for k, b in enumerate(boxes) if b is not None], dtype=np.int64)
-    trees, tris, n_tris, mesh_depth = _Trees(), [np.zeros((0, 12))], 0, 0
+    trees, mesh_depth = _Trees(), 0
     scene_bvh = BVH(np.array([boxes[k][0] for k in members]).reshape(-1, 3),
                     np.array([boxes[k][1] for k in members]).reshape(-1, 3), leaf_size=2)
     trees.add(scene_bvh, members)                    # root 0
+    pool = [np.zeros((0, POOL))]
+    n_pool = 0
     for k, o in enumerate(scene.objects):
-        if isinstance(o.shape, Mesh):
-            m = o.shape
-            ints[k, KIND], ints[k, ROOT] = MESH, trees.add(m.bvh, np.arange(len(m.a)) + n_tris)
-            tris.append(np.concatenate([m.a, m.e1, m.e2, m.face], axis=1))
-            n_tris, mesh_depth = n_tris + len(m.a), max(mesh_depth, m.bvh.depth)
+        shape = o.shape
+        if isinstance(shape, Mesh):
+            corners = shape.normal_corners
+            ints[k, KIND], ints[k, SMOOTH] = MESH, corners is not None
+            ints[k, ROOT] = trees.add(shape.bvh, np.arange(len(shape.a)) + n_pool)
+            corners = np.zeros((len(shape.a), 9)) if corners is None else corners.reshape(-1, 9)
+            pool.append(np.concatenate([shape.a, shape.e1, shape.e2, shape.face, corners], axis=1))
+            mesh_depth = max(mesh_depth, shape.bvh.depth)
+        elif isinstance(shape, Polygon):             # plane point and normal, projection axes, its vertices
+            ints[k, KIND], ints[k, ROOT] = POLYGON, n_pool
+            objects[k, :9] = [*shape.v[0], *shape.n, *shape.axes, len(shape.v)]
+            pool.append(np.concatenate([shape.v, np.zeros((len(shape.v), POOL - 3))], axis=1))
         else:
-            ints[k, KIND], row = _row(o.shape)
+            ints[k, KIND], row = _row(shape)
             objects[k, :len(row)] = row
+        n_pool += len(pool[-1])
         if o.world_from_object is not None:
             ints[k, XF] = 1
             objects[k, INV:INV + 12] = o.world_from_object.m_inv[:3, :].ravel()
@@ -119,7 +135,7 @@ def geometry(scene) -> tuple[Geometry, int]:
                                                       axis=1).ravel()
     ints[:, CASTS] = scene.materials.shadow[[o.material for o in scene.objects]]
     unbounded = np.array([k for k, b in enumerate(boxes) if b is None], dtype=np.int64)
-    geo = Geometry(objects, ints, unbounded, *trees.arrays(), np.ascontiguousarray(np.concatenate(tris)))
+    geo = Geometry(objects, ints, unbounded, *trees.arrays(), np.ascontiguousarray(np.concatenate(pool)))
     return geo, scene_bvh.depth + mesh_depth + 4
 
 

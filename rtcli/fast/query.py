@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 
-from rtcli.fast.pack import CASTS, INV, KIND, MESH, ROOT, XF
-from rtcli.fast.shapes import apply, hit, inline, jit, triangle
+from rtcli.fast.pack import CASTS, INV, KIND, MESH, POLYGON, ROOT, XF
+from rtcli.fast.shapes import apply, hit, inline, jit, plane, triangle
 
 
 @jit
@@ -39,7 +39,7 @@ def reciprocal(dx, dy, dz):
 
 
 @jit
-def mesh_hit(nodes, links, perm, tris, root, ox, oy, oz, dx, dy, dz, t_min, t_max, any_hit, stack, bottom):
+def mesh_hit(nodes, links, perm, pool, root, ox, oy, oz, dx, dy, dz, t_min, t_max, any_hit, stack, bottom):
     """(t, triangle) nearest in (t_min, t_max) through the mesh tree at `root`, using
     stack[bottom:]; triangle -1 on a miss."""
     o, inv = (ox, oy, oz), reciprocal(dx, dy, dz)
@@ -57,7 +57,7 @@ def mesh_hit(nodes, links, perm, tris, root, ox, oy, oz, dx, dy, dz, t_min, t_ma
             continue
         for j in range(start, start + count):
             p = perm[j]
-            tri = tris[p]
+            tri = pool[p]
             t = triangle(tri[0:3], tri[3:6], tri[6:9], ox, oy, oz, dx, dy, dz)
             if t_min < t < best:
                 best, won = t, p
@@ -75,15 +75,35 @@ def object_ray(row, transformed, ox, oy, oz, dx, dy, dz):
     return ox, oy, oz, dx, dy, dz
 
 
+@jit
+def polygon_hit(row, pool, first, ox, oy, oz, dx, dy, dz, t_min, t_max):
+    """Polygon.intersect: its plane, then the even-odd rule on the vertices pool[first:first + count]
+    projected on the axes (i, j): crossings of the ray from the point along +i."""
+    t = plane(row, ox, oy, oz, dx, dy, dz, t_min, t_max)
+    if t == np.inf:
+        return t
+    i, j, count = int(row[6]), int(row[7]), int(row[8])
+    p = (ox + t * dx, oy + t * dy, oz + t * dz)
+    px, py, inside = p[i], p[j], False
+    for r in range(count):
+        a, b = pool[first + r], pool[first + (r + 1) % count]
+        ax, ay, bx, by = a[i], a[j], b[i], b[j]
+        if (ay > py) != (by > py) and px < ax + (py - ay) * (bx - ax) / (by - ay):
+            inside = not inside
+    return t if inside else np.inf
+
+
 @inline
 def object_hit(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, any_hit, stack, bottom):
     """(t, prim) of scene object k for a world-space ray."""
     row, kind = g.objects[k], g.ints[k, KIND]
     ox, oy, oz, dx, dy, dz = object_ray(row, g.ints[k, XF], ox, oy, oz, dx, dy, dz)
-    if kind != MESH:
-        return hit(kind, row, ox, oy, oz, dx, dy, dz, t_min, t_max)
-    return mesh_hit(g.nodes, g.links, g.perm, g.tris, g.ints[k, ROOT], ox, oy, oz, dx, dy, dz, t_min, t_max,
-                    any_hit, stack, bottom)
+    if kind == MESH:
+        return mesh_hit(g.nodes, g.links, g.perm, g.pool, g.ints[k, ROOT], ox, oy, oz, dx, dy, dz, t_min, t_max,
+                        any_hit, stack, bottom)
+    if kind == POLYGON:
+        return polygon_hit(row, g.pool, g.ints[k, ROOT], ox, oy, oz, dx, dy, dz, t_min, t_max), 0
+    return hit(kind, row, ox, oy, oz, dx, dy, dz, t_min, t_max)
 
 
 @inline

@@ -11,6 +11,8 @@ Object rows (packed by rtcli/fast/pack.py) start with the shape's parameters:
   PLANE   point(3) n(3)
   BOX     lo(3) hi(3)
   TAPERED base(3) e1(3) e2(3) a(3) r h s0 s1 capped   (cylinder and cone)
+  TRIANGLE a(3) e1(3) e2(3) face(3) na(3) nb(3) nc(3) smooth   (as a mesh's pool row, plus the flag)
+  SQUARE  (none: z = 0, |x|, |y| <= 1)
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rtcli.fast.pack import BOX, PLANE, SPHERE
+from rtcli.fast.pack import BOX, PLANE, POLYGON, SPHERE, SQUARE, TAPERED, TRIANGLE
 
 # How the compiled engine's functions are built (measured on whitted at 960x540, ns per pixel):
 # - error_model="numpy": x / 0 gives inf or nan, as in the numpy core, instead of raising.
@@ -147,6 +149,16 @@ def tapered(p, ox, oy, oz, dx, dy, dz, t_min, t_max):
     return best, prim
 
 
+@jit
+def square(p, ox, oy, oz, dx, dy, dz, t_min, t_max):
+    """Square.intersect: the plane z = 0 within |x| <= 1, |y| <= 1."""
+    denom = dx * 0.0 + dy * 0.0 + dz * 1.0
+    t = ((0.0 * 0.0 + 0.0 * 0.0 + 0.0 * 1.0) - (ox * 0.0 + oy * 0.0 + oz * 1.0)) / denom
+    if not (denom != 0 and t_min < t < t_max):
+        return np.inf
+    return t if abs(ox + t * dx) <= 1 and abs(oy + t * dy) <= 1 else np.inf
+
+
 @inline
 def hit(kind, p, ox, oy, oz, dx, dy, dz, t_min, t_max):
     """(t, prim) of one shape for an object-space ray, inf on a miss."""
@@ -156,16 +168,25 @@ def hit(kind, p, ox, oy, oz, dx, dy, dz, t_min, t_max):
         return plane(p, ox, oy, oz, dx, dy, dz, t_min, t_max), 0
     if kind == BOX:
         return box(p, ox, oy, oz, dx, dy, dz, t_min, t_max)
-    return tapered(p, ox, oy, oz, dx, dy, dz, t_min, t_max)
+    if kind == TAPERED:
+        return tapered(p, ox, oy, oz, dx, dy, dz, t_min, t_max)
+    if kind == TRIANGLE:
+        t = triangle(p[0:3], p[3:6], p[6:9], ox, oy, oz, dx, dy, dz)
+        return (t if t_min < t < t_max else np.inf), 0
+    return square(p, ox, oy, oz, dx, dy, dz, t_min, t_max), 0
 
 
 @inline
 def normal(kind, p, x, y, z, prim):
-    """The outward normal (not unit for transformed objects) at the object-space point (x, y, z)."""
+    """The outward (geometric) normal, not unit, at the object-space point (x, y, z)."""
     if kind == SPHERE:
         return (x - p[0]) / p[3], (y - p[1]) / p[3], (z - p[2]) / p[3]
-    if kind == PLANE:
+    if kind == PLANE or kind == POLYGON:
         return p[3], p[4], p[5]
+    if kind == TRIANGLE:
+        return p[9], p[10], p[11]
+    if kind == SQUARE:
+        return 0.0, 0.0, 1.0
     if kind == BOX:
         sign = 1.0 if prim % 2 else -1.0
         k = prim // 2
@@ -182,6 +203,23 @@ def normal(kind, p, x, y, z, prim):
     if n[0] * n[0] + n[1] * n[1] + n[2] * n[2] == 0:                 # a cone's apex: along the axis
         return p[9], p[10], p[11]
     return n
+
+
+@jit
+def interpolated(t, x, y, z):
+    """Smooth normal of the triangle row t = (a, e1, e2, face, na, nb, nc) at (x, y, z):
+    planar.barycentric's (alpha, beta), then Mesh._interpolate."""
+    qx, qy, qz = x - t[0], y - t[1], z - t[2]
+    d00 = t[3] * t[3] + t[4] * t[4] + t[5] * t[5]
+    d01 = t[3] * t[6] + t[4] * t[7] + t[5] * t[8]
+    d11 = t[6] * t[6] + t[7] * t[7] + t[8] * t[8]
+    d20 = qx * t[3] + qy * t[4] + qz * t[5]
+    d21 = qx * t[6] + qy * t[7] + qz * t[8]
+    den = d00 * d11 - d01 * d01
+    alpha, beta = (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+    w = 1 - alpha - beta
+    return (w * t[12] + alpha * t[15] + beta * t[18], w * t[13] + alpha * t[16] + beta * t[19],
+            w * t[14] + alpha * t[17] + beta * t[20])
 
 
 @jit
