@@ -63,6 +63,7 @@ render: {max_depth: 6, specular: SPEC}
 lights:
   - {position: [4, 6, -5], color: [0.9, 0.9, 0.9], attenuation: [1, 0.02, 0.001]}
   - {position: [-3, 5, -2], color: [0.6, 0.5, 0.4], spot: {direction: [0.6, -1, 0.4], angle: 30, falloff: 4}}
+  - {position: [0, 6, 1], color: [0.3, 0.3, 0.35], area: {u: [1.5, 0, 0], v: [0, 0.3, 1.2], samples: 3}}
 materials:
   glass: {diffuse: 0.05, specular: 0.8, shininess: 50, reflection: 0.1, transmission: 0.85, ior: 1.45}
   mirror: {diffuse: 0.1, specular: 0.5, reflection: 0.7}
@@ -85,9 +86,9 @@ objects:
 
 
 @pytest.mark.parametrize("spec", ["phong", "blinn"])
-def test_transformed_shapes_glass_spots_and_attenuation(yaml_scene, spec):
+def test_transformed_shapes_glass_and_every_kind_of_light(yaml_scene, spec):
     """Every kind of shape the compiled engine has, most under transforms (a mirror one too),
-    a smooth glass triangle and a concave polygon."""
+    a smooth glass triangle and a concave polygon; attenuated, spot and area lights."""
     scene = yaml_scene(TRANSFORMED.replace("SPEC", spec))
     ids, _ = render(scene, Job(120, 90, signature=True))
     assert set(range(1, len(scene.objects) + 1)) <= set(np.unique(ids).tolist())    # each one in view
@@ -126,7 +127,6 @@ def test_unsupported_names_what_the_compiled_engine_lacks():
     reasons = {p.stem: fast.unsupported(load_scene(str(p))) for p in SCENES}
     assert reasons["csg"] == "csg objects"
     assert reasons["torus"] == "torus objects"
-    assert reasons["lights"] == "area lights"
     assert reasons["spot"] == "image textures"
     assert reasons["whitted"] is None
 

@@ -61,6 +61,63 @@ def texture(s, m, px, py, pz):
     return c[j], c[j + 1], c[j + 2]
 
 
+@jit
+def mix(x):
+    """splitmix64's finalizer (jitter._mix)."""
+    x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return x ^ (x >> np.uint64(31))
+
+
+@jit
+def uniform(s, x, y, z, cell, axis):
+    """jitter.uniform(x, y, z, cell, axis): a number in [0, 1) hashed from the floats' bits and two ints."""
+    golden = np.uint64(0x9E3779B97F4A7C15)
+    h = golden
+    for key in (x, y, z):
+        s.word[0] = key
+        h = mix(h ^ s.bits[0]) + golden
+    h = mix(h ^ np.uint64(cell)) + golden
+    h = mix(h ^ np.uint64(axis)) + golden
+    return np.float64(mix(h) >> np.uint64(11)) * (1.0 / (1 << 53))
+
+
+@inline
+def light_sample(g, s, m, T, light, points, qx, qy, qz, px, py, pz, nx, ny, nz, sx, sy, sz, Vx, Vy, Vz, NV,
+                 cr, cg, cb, counts, stack):
+    """One light position q's term, added to (cr, cg, cb): diffuse and specular if N.L > 0 and
+    the feeler from s (the hit point stepped off the surface) to q meets no shadow caster."""
+    lx, ly, lz = qx - px, qy - py, qz - pz
+    r = math.sqrt(lx * lx + ly * ly + lz * lz)
+    Lx, Ly, Lz = lx / r, ly / r, lz / r
+    NL = nx * Lx + ny * Ly + nz * Lz
+    if not NL > 0:                                                    # no contribution (004, case 2)
+        return cr, cg, cb
+    counts[SHADOW] += 1
+    if scene_hit(g, sx, sy, sz, qx - sx, qy - sy, qz - sz, 0.0, 1.0, True, stack)[1] >= 0:
+        return cr, cg, cb
+    spot = 1.0
+    if light[14] != 0:
+        cos = -(Lx * light[9] + Ly * light[10] + Lz * light[11])
+        spot = max(cos, 0.0) ** light[13] if cos >= light[12] else 0.0
+    weight = 1.0 / (light[6] + light[7] * r + light[8] * r * r) * spot / points
+    wNL = weight * NL
+    cr += wNL * light[3] * (s.kd[m, 0] * T[0])
+    cg += wNL * light[4] * (s.kd[m, 1] * T[1])
+    cb += wNL * light[5] * (s.kd[m, 2] * T[2])
+    if s.shiny[m]:
+        if s.blinn:
+            Hx, Hy, Hz = Lx + Vx, Ly + Vy, Lz + Vz
+            cos = (nx * Hx + ny * Hy + nz * Hz) / math.sqrt(Hx * Hx + Hy * Hy + Hz * Hz)
+        else:
+            cos = 2 * NL * NV - (Lx * Vx + Ly * Vy + Lz * Vz)
+        w = weight * max(cos, 0.0) ** s.shininess[m]
+        cr += w * light[3] * s.ks[m, 0]
+        cg += w * light[4] * s.ks[m, 1]
+        cb += w * light[5] * s.ks[m, 2]
+    return cr, cg, cb
+
+
 @inline
 def local(g, s, m, T, px, py, pz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, counts, stack):
     """shade.local for one hit: emission, ambient and the lights that see it."""
@@ -72,34 +129,19 @@ def local(g, s, m, T, px, py, pz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, counts, st
     sx, sy, sz = px + eps * gx, py + eps * gy, pz + eps * gz          # feelers leave from the lit side
     for li in range(len(s.lights)):
         light = s.lights[li]
-        lx, ly, lz = light[0] - px, light[1] - py, light[2] - pz
-        r = math.sqrt(lx * lx + ly * ly + lz * lz)
-        Lx, Ly, Lz = lx / r, ly / r, lz / r
-        NL = nx * Lx + ny * Ly + nz * Lz
-        if not NL > 0:                                                # no contribution (004, case 2)
-            continue
-        counts[SHADOW] += 1
-        if scene_hit(g, sx, sy, sz, light[0] - sx, light[1] - sy, light[2] - sz, 0.0, 1.0, True, stack)[1] >= 0:
-            continue
-        spot = 1.0
-        if light[14] != 0:
-            cos = -(Lx * light[9] + Ly * light[10] + Lz * light[11])
-            spot = max(cos, 0.0) ** light[13] if cos >= light[12] else 0.0
-        weight = 1.0 / (light[6] + light[7] * r + light[8] * r * r) * spot / 1
-        wNL = weight * NL
-        cr += wNL * light[3] * (s.kd[m, 0] * T[0])
-        cg += wNL * light[4] * (s.kd[m, 1] * T[1])
-        cb += wNL * light[5] * (s.kd[m, 2] * T[2])
-        if s.shiny[m]:
-            if s.blinn:
-                Hx, Hy, Hz = Lx + Vx, Ly + Vy, Lz + Vz
-                cos = (nx * Hx + ny * Hy + nz * Hz) / math.sqrt(Hx * Hx + Hy * Hy + Hz * Hz)
+        n = int(light[21])
+        points = n * n if n > 0 else 1                                # area lights: n x n jittered points
+        for cell in range(points):
+            if n > 0:
+                fu = (cell // n + uniform(s, px, py, pz, cell, 0)) / n - 0.5
+                fv = (cell % n + uniform(s, px, py, pz, cell, 1)) / n - 0.5
+                qx = light[0] + fu * light[15] + fv * light[18]
+                qy = light[1] + fu * light[16] + fv * light[19]
+                qz = light[2] + fu * light[17] + fv * light[20]
             else:
-                cos = 2 * NL * NV - (Lx * Vx + Ly * Vy + Lz * Vz)
-            w = weight * max(cos, 0.0) ** s.shininess[m]
-            cr += w * light[3] * s.ks[m, 0]
-            cg += w * light[4] * s.ks[m, 1]
-            cb += w * light[5] * s.ks[m, 2]
+                qx, qy, qz = light[0], light[1], light[2]
+            cr, cg, cb = light_sample(g, s, m, T, light, points, qx, qy, qz, px, py, pz, nx, ny, nz, sx, sy, sz,
+                                      Vx, Vy, Vz, NV, cr, cg, cb, counts, stack)
     return cr, cg, cb
 
 

@@ -3,8 +3,8 @@
 The compiled integrator handles the shapes most scenes are made of: spheres,
 planes, boxes, cylinders, cones, triangles, squares, polygons and triangle
 meshes (flat or smooth), each with any transform; materials with no texture or
-a checker; point and spot lights. Anything else (CSG, torus, image textures,
-area lights) keeps the numpy path: `unsupported(scene)` names the first such thing.
+a checker; point, spot and area lights. Anything else (CSG, torus, image
+textures) keeps the numpy path: `unsupported(scene)` names the first such thing.
 
 Geometry (`Geometry`): one row per scene object (see shapes.py for the row
 layout), the unbounded objects (planes) by index, and a BVH over the bounded
@@ -35,8 +35,9 @@ POOL = 21                                           # pool rows: a triangle's a,
 # Few arrays on purpose: numba passes each array as ~8 machine words per call.
 # pool: the triangles of every mesh, then the vertices of every polygon (x, y, z in a row).
 Geometry = namedtuple("Geometry", "objects ints unbounded nodes links perm pool")
+# word, bits: a float64 scratch cell and its uint64 view, for hashing a float's bits (jitter).
 Looks = namedtuple("Looks", "material ka kd ks emission kr kt shininess ior shiny mirror clear "
-                            "checker lights ambient background offset max_depth blinn")
+                            "checker lights ambient background offset max_depth blinn word bits")
 
 
 def unsupported(scene) -> str | None:
@@ -47,9 +48,6 @@ def unsupported(scene) -> str | None:
     for m in scene.materials.materials:
         if m.texture is not None and not isinstance(m.texture, Checker):
             return "image textures"
-    for light in scene.lights:
-        if light.area_u is not None:
-            return "area lights"
     return None
 
 
@@ -145,14 +143,17 @@ def looks(scene) -> Looks:
     for k, m in enumerate(table.materials):
         if m.texture is not None:
             checker[k] = [1.0, 1 / m.texture.size, *m.texture.color1, *m.texture.color2]
-    lights = np.zeros((len(scene.lights), 15))      # position, color, attenuation, spot axis, cos, falloff, spot?
-    for k, light in enumerate(scene.lights):
-        spot = light.spot_direction is not None
+    lights = np.zeros((len(scene.lights), 22))      # position, color, attenuation, spot axis, cos, falloff,
+    for k, light in enumerate(scene.lights):        # spot?, area u, v, n (0: a point light)
+        spot, area = light.spot_direction is not None, light.area_u is not None
         axis = light.spot_direction if spot else np.zeros(3)
+        u, v = (light.area_u, light.area_v) if area else (np.zeros(3), np.zeros(3))
         lights[k] = [*light.position, *light.color, *light.attenuation, *axis,
-                     light.spot_cos, light.spot_falloff, float(spot)]
+                     light.spot_cos, light.spot_falloff, float(spot), *u, *v, light.area_samples if area else 0]
     material = np.array([o.material for o in scene.objects], dtype=np.int64)
+    word = np.zeros(1)
     return Looks(material, table.ka, table.kd, table.ks, table.emission, table.kr, table.kt, table.n, table.ior,
                  table.shiny.astype(np.int64), table.mirror.astype(np.int64), table.clear.astype(np.int64),
                  checker, lights, np.asarray(scene.ambient, float), np.asarray(scene.background, float),
-                 float(scene.offset), int(scene.settings.max_depth), int(scene.settings.specular == "blinn"))
+                 float(scene.offset), int(scene.settings.max_depth), int(scene.settings.specular == "blinn"),
+                 word, word.view(np.uint64))

@@ -19,8 +19,9 @@ from rtcli.fast.shapes import apply, hit, inline, jit, plane, triangle
 
 
 @jit
-def slab(nodes, node, o, inv, t_near, t_far):
-    """The ray meets node's box within [t_near, t_far] (bvh.slab; a NaN from 0 x inf does not constrain)."""
+def entry(nodes, node, o, inv, t_near, t_far):
+    """Where the ray enters node's box within [t_near, t_far], inf if it does not
+    (bvh.slab; a NaN from 0 x inf does not constrain)."""
     for k in range(3):
         t1 = (nodes[node, k] - o[k]) * inv[k]
         t2 = (nodes[node, 3 + k] - o[k]) * inv[k]
@@ -28,7 +29,23 @@ def slab(nodes, node, o, inv, t_near, t_far):
             continue
         t_near = max(t_near, min(t1, t2))
         t_far = min(t_far, max(t1, t2))
-    return t_near <= t_far
+    return t_near if t_near <= t_far else np.inf
+
+
+@jit
+def push_children(nodes, child, o, inv, t_min, best, stack, top):
+    """Push the children of a node whose boxes the ray enters before `best`, the nearer on top."""
+    near, far = entry(nodes, child, o, inv, t_min, best), entry(nodes, child + 1, o, inv, t_min, best)
+    first, second = child, child + 1
+    if far < near:
+        near, far, first, second = far, near, second, first
+    if far < np.inf:
+        stack[top] = second
+        top += 1
+    if near < np.inf:
+        stack[top] = first
+        top += 1
+    return top
 
 
 @jit
@@ -48,12 +65,11 @@ def mesh_hit(nodes, links, perm, pool, root, ox, oy, oz, dx, dy, dz, t_min, t_ma
     while top > bottom:
         top -= 1
         node = stack[top]
-        if not slab(nodes, node, o, inv, t_min, best):
+        if entry(nodes, node, o, inv, t_min, best) == np.inf:     # best may have shrunk since the push
             continue
         child, start, count = links[node, 0], links[node, 1], links[node, 2]
         if child >= 0:
-            stack[top], stack[top + 1] = child + 1, child
-            top += 2
+            top = push_children(nodes, child, o, inv, t_min, best, stack, top)
             continue
         for j in range(start, start + count):
             p = perm[j]
@@ -125,12 +141,11 @@ def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
     while top > 0:
         top -= 1
         node = stack[top]
-        if not slab(g.nodes, node, o, inv, t_min, best):
+        if entry(g.nodes, node, o, inv, t_min, best) == np.inf:
             continue
         child, start, count = g.links[node, 0], g.links[node, 1], g.links[node, 2]
         if child >= 0:
-            stack[top], stack[top + 1] = child + 1, child
-            top += 2
+            top = push_children(g.nodes, child, o, inv, t_min, best, stack, top)
             continue
         for j in range(start, start + count):
             k = g.perm[j]
