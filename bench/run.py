@@ -8,7 +8,10 @@ then checked against POV-Ray's with a loose gate, and the share of pixels that
 differ by more than 10% in some channel is reported: the pictures should show
 the same objects, lights and shadows.
 
-    python bench/run.py [--runs 3] [--sizes 640x480,1920x1080] [--scenes whitted,quadrics]
+    python bench/run.py [--runs 3] [--sizes 640x480,1920x1080] [--scenes whitted,quadrics] [--engine auto]
+
+The engine column says which engine rtcli used (`--engine auto` picks numpy for
+the small size and the compiled integrator for the large one).
 """
 
 from __future__ import annotations
@@ -39,9 +42,9 @@ def timed(cmd: list[str], cwd: str) -> tuple[float, str]:
     return seconds, done.stdout
 
 
-def rtcli_cmd(scene, out, w, h, workers):
-    return [sys.executable, "-m", "rtcli", "render", f"{scene}.yaml", "-o", out,
-            "--width", str(w), "--height", str(h), "--quiet", "--stats", "--workers", str(workers)]
+def rtcli_cmd(scene, out, w, h, workers, engine):
+    return [sys.executable, "-m", "rtcli", "render", f"{scene}.yaml", "-o", out, "--width", str(w),
+            "--height", str(h), "--quiet", "--stats", "--workers", str(workers), "--engine", engine]
 
 
 def povray_cmd(scene, out, w, h, workers):
@@ -77,14 +80,15 @@ def framed_like_povray(scene: str, w: int, h: int) -> str:
     return name
 
 
-def bench(scene, w, h, runs, workers, tmp, pov):
+def bench(scene, w, h, runs, workers, engine, tmp, pov):
     rt_scene = framed_like_povray(scene, w, h)
-    rt_out, pov_out = os.path.join(tmp, f"{scene}_rt.png"), os.path.join(tmp, f"{scene}_pov.png")
+    rt_out, pov_out = os.path.join(tmp, f"{scene}_{w}x{h}_rt.png"), os.path.join(tmp, f"{scene}_{w}x{h}_pov.png")
     rt_times, pov_times, rays = [], [], 0
     for _ in range(runs):
-        seconds, stdout = timed(rtcli_cmd(rt_scene, rt_out, w, h, workers), HERE)
+        seconds, stdout = timed(rtcli_cmd(rt_scene, rt_out, w, h, workers, engine), HERE)
         rt_times.append(seconds)
         rays = int(re.search(r"(\d+) total", stdout).group(1))
+        used = re.search(r"(\w+) engine", stdout).group(1)
         if pov:
             pov_times.append(timed(povray_cmd(scene, pov_out, w, h, workers), HERE)[0])
     if rt_scene != scene:
@@ -92,7 +96,7 @@ def bench(scene, w, h, runs, workers, tmp, pov):
     rt = statistics.median(rt_times)
     pv = statistics.median(pov_times) if pov else float("nan")
     share = differing_share(rt_out, pov_out) if pov else float("nan")
-    return rt, pv, rays / rt, share
+    return rt, pv, rays / rt, share, used
 
 
 def main():
@@ -101,6 +105,7 @@ def main():
     ap.add_argument("--sizes", default="640x480,1920x1080")
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--engine", default="auto", choices=["auto", "numpy", "compiled"])
     ap.add_argument("--keep", help="folder to keep the rendered images in")
     args = ap.parse_args()
     pov = shutil.which("povray") is not None
@@ -108,12 +113,13 @@ def main():
         print("povray not found (apt-get install povray): timing rtcli alone")
     tmp = args.keep or tempfile.mkdtemp(prefix="rtcli-bench-")
     os.makedirs(tmp, exist_ok=True)
-    print(f"{'scene':<10} {'size':>9} {'rtcli s':>8} {'POV-Ray s':>9} {'ratio':>6} {'rtcli rays/s':>13} {'differ':>7}")
+    print(f"{'scene':<10} {'size':>9} {'engine':>8} {'rtcli s':>8} {'POV-Ray s':>9} {'ratio':>6} "
+          f"{'rtcli rays/s':>13} {'differ':>7}")
     for scene in args.scenes.split(","):
         for size in args.sizes.split(","):
             w, h = (int(x) for x in size.split("x"))
-            rt, pv, rate, share = bench(scene, w, h, args.runs, args.workers, tmp, pov)
-            print(f"{scene:<10} {size:>9} {rt:8.2f} {pv:9.2f} {rt / pv:6.2f} {rate:13,.0f} {share:7.1%}",
+            rt, pv, rate, share, used = bench(scene, w, h, args.runs, args.workers, args.engine, tmp, pov)
+            print(f"{scene:<10} {size:>9} {used:>8} {rt:8.2f} {pv:9.2f} {rt / pv:6.2f} {rate:13,.0f} {share:7.1%}",
                   flush=True)
     print(f"images in {tmp}")
 
