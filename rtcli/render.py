@@ -70,9 +70,11 @@ def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
         ids = np.array([o.id for o in scene.objects] + [0], dtype=np.uint16)
         return ids[hits.obj], stats
     xs, ys = sample_positions(i, j, scene.settings.samples)
-    rays = cam.rays(xs.ravel(), ys.ravel(), job.width, job.height)
-    stats.primary += len(rays)
-    colors = compiled.trace(rays, stats) if compiled else trace(scene, rays, 1, stats)
+    stats.primary += xs.size
+    if compiled:
+        colors = compiled.trace_pixels(cam, xs.ravel(), ys.ravel(), job.width, job.height, stats)
+    else:
+        colors = trace(scene, cam.rays(xs.ravel(), ys.ravel(), job.width, job.height), 1, stats)
     colors = colors.reshape(len(xs), len(i), 3)
     return colors.mean(axis=0), stats
 
@@ -146,7 +148,7 @@ def _map_tiles(scene: Scene, compiled, job: Job, tiles: list, workers: int):
             yield _run_tile(scene, compiled, job, rows, cols)
         return
     if compiled:
-        compiled.warm_up()                 # loaded once here, not once per worker
+        compiled.warm_up(scene.camera(job.width, job.height))   # loaded once here, not once per worker
     elif _uses_kernels(scene):
         kernels.warm_up()
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")

@@ -27,29 +27,31 @@ import numpy as np
 from rtcli import kernels
 from rtcli.errors import RtcliError
 from rtcli.fast.pack import unsupported
-from rtcli.rays import Rays
 from rtcli.stats import Stats
 
 class Compiled:
-    """A scene packed for the compiled integrator; trace() stands in for trace.trace(depth=1)."""
+    """A scene packed for the compiled integrator; trace_pixels() stands in for camera rays + trace.trace."""
 
     def __init__(self, scene):
         from rtcli.fast.pack import geometry, looks
         self.geometry, stack = geometry(scene)
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
 
-    def trace(self, rays: Rays, stats: Stats) -> np.ndarray:
-        from rtcli.fast.integrator import trace_rays
+    def trace_pixels(self, cam, x: np.ndarray, y: np.ndarray, nc: int, nr: int, stats: Stats) -> np.ndarray:
+        """Colors of the camera's rays through pixel coordinates (x, y): trace(cam.rays(x, y, nc, nr))
+        without building the rays in numpy."""
+        from rtcli.fast.integrator import trace_camera
         counts = np.zeros(4, dtype=np.int64)
-        colors = trace_rays(self.geometry, self.looks, np.ascontiguousarray(rays.origin, dtype=float),
-                            np.ascontiguousarray(rays.direction, dtype=float), counts, self.stack)
+        x, y = (np.ascontiguousarray(v, dtype=float) for v in (x, y))
+        colors = trace_camera(self.geometry, self.looks, *(np.asarray(v, dtype=float) for v in
+                              (cam.eye, cam.origin, cam.right, cam.down)), x, y, nc, nr, counts, self.stack)
         stats.add(Stats(*(int(c) for c in counts)))
         return colors
 
-    def warm_up(self) -> None:
+    def warm_up(self, cam) -> None:
         """Compile, or load from the cache, now: worker processes forked later inherit the code."""
-        one = np.zeros((1, 3))
-        self.trace(Rays(one, one + 1), Stats())
+        one = np.zeros(1)
+        self.trace_pixels(cam, one, one, 1, 1, Stats())
 
 
 def _drop_stale_cache() -> None:

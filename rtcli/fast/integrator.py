@@ -223,12 +223,16 @@ def radiance(g, s, ray, counts, frames, stack):
 
 
 @entry
-def trace_rays(g, s, origin, direction, counts, stack):
-    """(n, 3) colors of the primary rays (origin, direction) (n, 3)."""
-    n = len(origin)
+def trace_camera(g, s, eye, origin, right, down, x, y, nc, nr, counts, stack):
+    """(n, 3) colors of the primary rays through the pixel coordinates (x, y) (n,) of a
+    camera.Camera: from the eye through origin + (x / nc) right + (y / nr) down."""
+    n = len(x)
     out = np.empty((n, 3))
     frames = np.empty((max(s.max_depth, 1), 18))
     for i in range(n):
-        ray = (origin[i, 0], origin[i, 1], origin[i, 2], direction[i, 0], direction[i, 1], direction[i, 2])
+        a, b = x[i] / nc, y[i] / nr
+        px, py, pz = (origin[0] + a * right[0] + b * down[0], origin[1] + a * right[1] + b * down[1],
+                      origin[2] + a * right[2] + b * down[2])
+        ray = (eye[0], eye[1], eye[2], px - eye[0], py - eye[1], pz - eye[2])
         out[i] = radiance(g, s, ray, counts, frames, stack)
     return out
