@@ -140,7 +140,6 @@ def test_unsupported_names_what_the_compiled_engine_lacks():
     reasons = {p.stem: fast.unsupported(load_scene(str(p))) for p in SCENES}
     assert reasons["csg"] == "csg objects"
     assert reasons["torus"] == "torus objects"
-    assert reasons["spot"] == "image textures"
     assert reasons["whitted"] is None
 
 
@@ -163,7 +162,7 @@ def test_a_source_change_drops_the_cached_machine_code(tmp_path, monkeypatch):
     """numba alone would keep machine code built from an older shapes.py inside integrator's cache."""
     package = tmp_path / "fast"
     (package / "__pycache__").mkdir(parents=True)
-    for name in ("pack.py", "shapes.py", "query.py", "integrator.py"):
+    for name in fast.SOURCES:
         (package / name).write_text(f"# {name}\n")
     stale = package / "__pycache__" / "integrator.trace_rays-1.py311.nbi"
     stale.write_text("old")
@@ -176,3 +175,31 @@ def test_a_source_change_drops_the_cached_machine_code(tmp_path, monkeypatch):
     (package / "shapes.py").write_text("# changed\n")
     fast._drop_stale_cache()
     assert not stale.exists()
+
+
+def test_image_textures_on_every_shape(yaml_scene, tmp_path):
+    """(u, v) of every compiled shape, under transforms, tiled and clamped pictures."""
+    rng = np.random.default_rng(2)
+    from PIL import Image
+    Image.fromarray(rng.integers(0, 256, (7, 5, 3), dtype=np.uint8)).save(tmp_path / "noise.png")
+    scene = yaml_scene("""
+        camera: {eye: [0, 3, -9], look_at: [0, 0.5, 0], fov: 50}
+        lights: [{position: [4, 6, -5], color: [1, 1, 1]}]
+        materials:
+          tiled: {texture: {image: noise.png}}
+          clamped: {texture: {image: noise.png, repeat: false}}
+        objects:
+          - {plane: {point: [0, -1, 0], normal: [0, 1, 0.2]}, material: tiled}
+          - {sphere: {radius: 0.8}, material: clamped, transform: [{scale: [1, 1.3, 1]}, {rotate: {axis: [0, 1, 1], degrees: 40}}, {translate: [-2.2, 0.5, 0]}]}
+          - {box: {min: [-0.5, -0.5, -0.5], max: [0.7, 0.4, 0.5]}, material: tiled, transform: [{rotate: {axis: [1, 1, 0], degrees: 35}}, {translate: [0, 0.2, -1]}]}
+          - {cylinder: {base: [0, -0.8, 0], top: [0, 0.8, 0], radius: 0.5}, material: clamped, transform: [{rotate: {axis: [1, 0, 0], degrees: -35}}, {translate: [2.2, 0.3, 0]}]}
+          - {cone: {base: [0, 0, 0], top: [0, 1, 0], radius: 0.6, top_radius: 0.3}, material: tiled, transform: [{rotate: {axis: [1, 0, 0], degrees: -60}}, {translate: [1, 1.8, 1]}]}
+          - {square: {}, material: clamped, transform: [{translate: [-1, 1.8, 1.5]}]}
+          - {triangle: {vertices: [[0.5, -1, 2], [2, -1, 2], [1.2, 0.5, 2]]}, material: tiled}
+          - {polygon: {vertices: [[-3.5, -1, 2.5], [-2, -1, 2.5], [-2.6, 0, 2.5], [-2, 1, 2.5], [-3.5, 1, 2.5]]}, material: clamped}
+        """)
+    ids, _ = render(scene, Job(120, 90, signature=True))
+    assert set(range(1, len(scene.objects) + 1)) <= set(np.unique(ids).tolist())
+    a, b, _, _ = both(scene, 120, 90)
+    assert np.array_equal(a, b)
+    assert len(np.unique(b.reshape(-1, 3), axis=0)) > 2000

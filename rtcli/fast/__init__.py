@@ -54,12 +54,15 @@ class Compiled:
         self.trace_pixels(cam, one, one, 1, 1, Stats())
 
 
+SOURCES = ("pack.py", "shapes.py", "query.py", "uv.py", "integrator.py")     # what the machine code is made of
+
+
 def _drop_stale_cache() -> None:
     """Delete numba's cached machine code of this package when its sources differ from the
     ones it was compiled from (a fingerprint kept beside it)."""
     here = Path(__file__).parent
     cache, digest = here / "__pycache__", hashlib.sha256()
-    for name in ("pack.py", "shapes.py", "query.py", "integrator.py"):          # what the machine code is made of
+    for name in SOURCES:
         digest.update((here / name).read_bytes())
     stamp = cache / "rtcli-fast.sha256"
     try:

@@ -17,9 +17,10 @@ import math
 
 import numpy as np
 
-from rtcli.fast.pack import KIND, MESH, NRM, SMOOTH, TRIANGLE, XF
+from rtcli.fast.pack import IMAGE, KIND, MESH, NO_TEXTURE, NRM, SMOOTH, TRIANGLE, XF
 from rtcli.fast.query import object_ray, scene_hit
 from rtcli.fast.shapes import apply, entry, inline, interpolated, jit, normal
+from rtcli.fast.uv import image, uv
 
 SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
 
@@ -51,11 +52,16 @@ def surface(g, k, prim, t, ox, oy, oz, dx, dy, dz):
 
 
 @inline
-def texture(s, m, px, py, pz):
-    """T at the object-space point: 1 without a texture, else the checker's color (textures.Checker)."""
-    c = s.checker[m]
-    if c[0] == 0:
+def texture(g, s, m, k, prim, px, py, pz):
+    """T at the object-space point: 1 without a texture, else the checker's color
+    (textures.Checker) or the picture's at the shape's (u, v) (textures.ImageTexture)."""
+    c = s.texture[m]
+    if c[0] == NO_TEXTURE:
         return 1.0, 1.0, 1.0
+    if c[0] == IMAGE:
+        kind, row = g.ints[k, KIND], g.objects[k]
+        u, v = uv(kind, row, g.pool[prim] if kind == MESH else row, prim, px, py, pz)
+        return image(s.texels, c, u, v)
     cells = np.floor(px * c[1] + 1e-6) + np.floor(py * c[1] + 1e-6) + np.floor(pz * c[1] + 1e-6)
     j = 2 if cells % 2.0 == 0 else 5                                # an integer, as a float: even or odd
     return c[j], c[j + 1], c[j + 2]
@@ -163,8 +169,8 @@ def shade_local(g, s, ray, f, counts, stack):
     m = s.material[k]
     length = math.sqrt(dx * dx + dy * dy + dz * dz)
     Dx, Dy, Dz = dx / length, dy / length, dz / length
-    cr, cg, cb = local(g, s, m, texture(s, m, qx, qy, qz), px, py, pz, nx, ny, nz, gx, gy, gz, -Dx, -Dy, -Dz,
-                       counts, stack)
+    T = texture(g, s, m, k, prim, qx, qy, qz)
+    cr, cg, cb = local(g, s, m, T, px, py, pz, nx, ny, nz, gx, gy, gz, -Dx, -Dy, -Dz, counts, stack)
     f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8] = cr, cg, cb, px, py, pz, nx, ny, nz
     f[9], f[10], f[11], f[12], f[13], f[14] = Dx, Dy, Dz, 1.0 if entering else 0.0, m, 0
     f[15], f[16], f[17] = gx, gy, gz

@@ -2,15 +2,16 @@
 
 The compiled integrator handles the shapes most scenes are made of: spheres,
 planes, boxes, cylinders, cones, triangles, squares, polygons and triangle
-meshes (flat or smooth), each with any transform; materials with no texture or
-a checker; point, spot and area lights. Anything else (CSG, torus, image
-textures) keeps the numpy path: `unsupported(scene)` names the first such thing.
+meshes (flat or smooth), each with any transform; checker and image textures;
+point, spot and area lights. Anything else (CSG, torus) keeps the numpy path:
+`unsupported(scene)` names the first such thing.
 
 Geometry (`Geometry`): one row per scene object (see shapes.py for the row
 layout), the unbounded objects (planes) by index, and a BVH over the bounded
 ones. Meshes put their triangles and BVH nodes in shared arrays, polygons their
-vertices; an object's integers say where its own start. Looks (`Looks`): the MaterialTable's arrays, the
-checker of each material, the lights and the scene constants.
+vertices; an object's integers say where its own start. Looks (`Looks`): the
+MaterialTable's arrays, each material's texture (image textures put their
+texels in one shared array), the lights and the scene constants.
 """
 
 from __future__ import annotations
@@ -25,19 +26,21 @@ from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.planar import Plane, Polygon, Square, Triangle
 from rtcli.shapes.quadric import _Tapered
 from rtcli.shapes.sphere import Sphere
-from rtcli.textures import Checker
+from rtcli.textures import Checker, ImageTexture
 
 SPHERE, PLANE, BOX, TAPERED, TRIANGLE, SQUARE, MESH, POLYGON = range(8)    # shape kinds, as in shapes.py
 INV, NRM, WIDTH = 24, 36, 48                        # columns of an object row: parameters, object_from_world, A^-T
 KIND, XF, CASTS, ROOT, SMOOTH = range(5)            # columns of an object's integers
-POOL = 21                                           # pool rows: a triangle's a, e1, e2, face, corner normals
+POOL = 27                                           # pool rows: a triangle's a, e1, e2, face, corner normals, uvs
 
 # Few arrays on purpose: numba passes each array as ~8 machine words per call.
 # pool: the triangles of every mesh, then the vertices of every polygon (x, y, z in a row).
 Geometry = namedtuple("Geometry", "objects ints unbounded nodes links perm pool")
 # word, bits: a float64 scratch cell and its uint64 view, for hashing a float's bits (jitter).
 Looks = namedtuple("Looks", "material ka kd ks emission kr kt shininess ior shiny mirror clear "
-                            "checker lights ambient background offset max_depth blinn word bits")
+                            "texture texels lights ambient background offset max_depth blinn word bits")
+NO_TEXTURE, CHECKER, IMAGE = 0, 1, 2                # texture rows: kind, 1 / size, color1, color2, and for
+                                                    # images: first texel, width, height, repeat
 
 
 def unsupported(scene) -> str | None:
@@ -45,9 +48,6 @@ def unsupported(scene) -> str | None:
     for o in scene.objects:
         if not isinstance(o.shape, (Sphere, Plane, Box, _Tapered, Mesh, Triangle, Square, Polygon)):
             return f"{o.kind or type(o.shape).__name__} objects"
-    for m in scene.materials.materials:
-        if m.texture is not None and not isinstance(m.texture, Checker):
-            return "image textures"
     return None
 
 
@@ -56,7 +56,7 @@ def _row(shape) -> tuple[int, list]:
     if isinstance(shape, Sphere):
         return SPHERE, [*shape.center, shape.radius, shape.radius ** 2]
     if isinstance(shape, Plane):
-        return PLANE, [*shape.point, *shape.n]
+        return PLANE, [*shape.point, *shape.n, *shape.e1, *shape.e2]
     if isinstance(shape, Box):
         return BOX, [*shape.lo, *shape.hi]
     if isinstance(shape, Square):
@@ -116,11 +116,12 @@ def geometry(scene) -> tuple[Geometry, int]:
             ints[k, KIND], ints[k, SMOOTH] = MESH, corners is not None
             ints[k, ROOT] = trees.add(shape.bvh, np.arange(len(shape.a)) + n_pool)
             corners = np.zeros((len(shape.a), 9)) if corners is None else corners.reshape(-1, 9)
-            pool.append(np.concatenate([shape.a, shape.e1, shape.e2, shape.face, corners], axis=1))
+            uvs = np.full((len(shape.a), 6), np.nan) if shape.uv_corners is None else shape.uv_corners.reshape(-1, 6)
+            pool.append(np.concatenate([shape.a, shape.e1, shape.e2, shape.face, corners, uvs], axis=1))
             mesh_depth = max(mesh_depth, shape.bvh.depth)
         elif isinstance(shape, Polygon):             # plane point and normal, projection axes, its vertices
             ints[k, KIND], ints[k, ROOT] = POLYGON, n_pool
-            objects[k, :9] = [*shape.v[0], *shape.n, *shape.axes, len(shape.v)]
+            objects[k, :15] = [*shape.v[0], *shape.n, *shape.axes, len(shape.v), *shape.e1, *shape.e2]
             pool.append(np.concatenate([shape.v, np.zeros((len(shape.v), POOL - 3))], axis=1))
         else:
             ints[k, KIND], row = _row(shape)
@@ -139,10 +140,14 @@ def geometry(scene) -> tuple[Geometry, int]:
 
 def looks(scene) -> Looks:
     table = scene.materials
-    checker = np.zeros((len(table), 8))             # textured?, 1 / size, color1, color2
+    texture, texels = np.zeros((len(table), 12)), [np.zeros((0, 3))]
     for k, m in enumerate(table.materials):
-        if m.texture is not None:
-            checker[k] = [1.0, 1 / m.texture.size, *m.texture.color1, *m.texture.color2]
+        if isinstance(m.texture, Checker):
+            texture[k, :8] = [CHECKER, 1 / m.texture.size, *m.texture.color1, *m.texture.color2]
+        elif isinstance(m.texture, ImageTexture):
+            h, w, _ = m.texture.texels.shape
+            texture[k] = [IMAGE, 0, 0, 0, 0, 0, 0, 0, sum(map(len, texels)), w, h, float(m.texture.repeat)]
+            texels.append(m.texture.texels.reshape(-1, 3))
     lights = np.zeros((len(scene.lights), 22))      # position, color, attenuation, spot axis, cos, falloff,
     for k, light in enumerate(scene.lights):        # spot?, area u, v, n (0: a point light)
         spot, area = light.spot_direction is not None, light.area_u is not None
@@ -154,6 +159,6 @@ def looks(scene) -> Looks:
     word = np.zeros(1)
     return Looks(material, table.ka, table.kd, table.ks, table.emission, table.kr, table.kt, table.n, table.ior,
                  table.shiny.astype(np.int64), table.mirror.astype(np.int64), table.clear.astype(np.int64),
-                 checker, lights, np.asarray(scene.ambient, float), np.asarray(scene.background, float),
+                 texture, np.ascontiguousarray(np.concatenate(texels), dtype=float), lights, np.asarray(scene.ambient, float), np.asarray(scene.background, float),
                  float(scene.offset), int(scene.settings.max_depth), int(scene.settings.specular == "blinn"),
                  word, word.view(np.uint64))

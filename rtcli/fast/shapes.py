@@ -8,11 +8,12 @@ there, and normals back, as transform.py does.
 
 Object rows (packed by rtcli/fast/pack.py) start with the shape's parameters:
   SPHERE  cx cy cz r r^2
-  PLANE   point(3) n(3)
+  PLANE   point(3) n(3) e1(3) e2(3)   (e1, e2: the (u, v) axes)
   BOX     lo(3) hi(3)
   TAPERED base(3) e1(3) e2(3) a(3) r h s0 s1 capped   (cylinder and cone)
   TRIANGLE a(3) e1(3) e2(3) face(3) na(3) nb(3) nc(3) smooth   (as a mesh's pool row, plus the flag)
   SQUARE  (none: z = 0, |x|, |y| <= 1)
+  POLYGON v0(3) n(3) axes(2) count e1(3) e2(3)   (its vertices in the pool)
 """
 
 from __future__ import annotations
@@ -206,9 +207,8 @@ def normal(kind, p, x, y, z, prim):
 
 
 @jit
-def interpolated(t, x, y, z):
-    """Smooth normal of the triangle row t = (a, e1, e2, face, na, nb, nc) at (x, y, z):
-    planar.barycentric's (alpha, beta), then Mesh._interpolate."""
+def barycentric(t, x, y, z):
+    """planar.barycentric: (alpha, beta) of (x, y, z) in the plane of the triangle row t = (a, e1, e2, ...)."""
     qx, qy, qz = x - t[0], y - t[1], z - t[2]
     d00 = t[3] * t[3] + t[4] * t[4] + t[5] * t[5]
     d01 = t[3] * t[6] + t[4] * t[7] + t[5] * t[8]
@@ -216,10 +216,21 @@ def interpolated(t, x, y, z):
     d20 = qx * t[3] + qy * t[4] + qz * t[5]
     d21 = qx * t[6] + qy * t[7] + qz * t[8]
     den = d00 * d11 - d01 * d01
-    alpha, beta = (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
-    w = 1 - alpha - beta
-    return (w * t[12] + alpha * t[15] + beta * t[18], w * t[13] + alpha * t[16] + beta * t[19],
-            w * t[14] + alpha * t[17] + beta * t[20])
+    return (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+
+
+@jit
+def corners(t, at, size, alpha, beta, j):
+    """Mesh._interpolate: component j of the corner values t[at:at + 3 size] (a, b, c, each `size` long)."""
+    return (1 - alpha - beta) * t[at + j] + alpha * t[at + size + j] + beta * t[at + 2 * size + j]
+
+
+@jit
+def interpolated(t, x, y, z):
+    """Smooth normal of the triangle row t = (a, e1, e2, face, na, nb, nc) at (x, y, z)."""
+    alpha, beta = barycentric(t, x, y, z)
+    return (corners(t, 12, 3, alpha, beta, 0), corners(t, 12, 3, alpha, beta, 1),
+            corners(t, 12, 3, alpha, beta, 2))
 
 
 @jit
