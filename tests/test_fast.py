@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from rtcli import fast, kernels
+from rtcli.accel import Accelerator
 from rtcli.build import load_scene
 from rtcli.errors import RtcliError
 from rtcli.render import Job, render, render_tile
@@ -99,10 +100,14 @@ objects:
 
 
 @pytest.mark.parametrize("spec", ["phong", "blinn"])
-def test_transformed_shapes_glass_and_every_kind_of_light(yaml_scene, spec):
+@pytest.mark.parametrize("accel", [False, True])
+def test_transformed_shapes_glass_and_every_kind_of_light(yaml_scene, spec, accel):
     """Every kind of shape the compiled engine has, most under transforms (a mirror one too),
-    a smooth glass triangle and a concave polygon; attenuated, spot and area lights."""
+    a smooth glass triangle and a concave polygon; attenuated, spot and area lights; with and
+    without the numpy core's Accelerator."""
     scene = yaml_scene(TRANSFORMED.replace("SPEC", spec))
+    if accel:
+        scene.accel = Accelerator(scene)
     ids, _ = render(scene, Job(120, 90, signature=True))
     assert set(range(1, len(scene.objects) + 1)) <= set(np.unique(ids).tolist())    # each one in view
     a, b, sa, sb = both(scene, 120, 90)
@@ -120,6 +125,13 @@ def test_samples_max_depth_block_size_and_workers(yaml_scene):
     assert np.array_equal(b, c)
 
 
+def with_accelerator(scene):
+    """The scene as load_scene prepares it: an Accelerator once it has 8 bounded objects."""
+    if Accelerator.wanted(scene):
+        scene.accel = Accelerator(scene)
+    return scene
+
+
 def test_many_objects_go_through_the_scene_bvh(yaml_scene):
     rng = np.random.default_rng(5)
     balls = "\n".join(f"  - {{sphere: {{center: [{x:.3f}, {y:.3f}, {z:.3f}], radius: {r:.3f}}}, "
@@ -131,6 +143,8 @@ def test_many_objects_go_through_the_scene_bvh(yaml_scene):
         objects:
         {balls}
         """.replace("\n        ", "\n"))
+    assert fast.Compiled(scene).geometry.links.shape[0] == 1        # no Accelerator: objects in file order
+    with_accelerator(scene)
     assert fast.Compiled(scene).geometry.links.shape[0] > 1
     a, b, _, _ = both(scene, 80, 80)
     assert np.array_equal(a, b)
@@ -203,3 +217,39 @@ def test_image_textures_on_every_shape(yaml_scene, tmp_path):
     a, b, _, _ = both(scene, 120, 90)
     assert np.array_equal(a, b)
     assert len(np.unique(b.reshape(-1, 3), axis=0)) > 2000
+
+
+@pytest.mark.parametrize("order", ["floor first", "floor last"])
+def test_ties_with_the_floor_go_to_the_same_object(yaml_scene, order):
+    """A glass cylinder's base cap and a polygon lie on the floor plane: coplanar surfaces, hit at
+    the same t. Both engines give such a tie to the object listed first."""
+    floor = "  - {plane: {}, material: {texture: {checker: {colors: [[1, 1, 1], [0.2, 0.2, 0.2]], size: 0.5}}}}"
+    others = """
+  - {cylinder: {base: [0, 0, 0], top: [0, 1.5, 0], radius: 0.7}, material: {diffuse: 0.05, transmission: 0.9, ior: 1.5}}
+  - {polygon: {vertices: [[1, 0, -1], [2, 0, -1], [2, 0, 0], [1, 0, 0]]}, material: {diffuse: [0.9, 0.1, 0.1]}}"""
+    objects = floor + others if order == "floor first" else others + "\n" + floor
+    scene = yaml_scene("""
+camera: {eye: [0, 2, 5], look_at: [0, 0.5, 0], fov: 45}
+lights: [{position: [3, 5, 4]}]
+objects:""" + ("\n" if order == "floor first" else "") + objects + "\n")
+    a, b, sa, sb = both(scene, 96, 72)
+    assert np.array_equal(a, b)
+    assert sa.refracted == sb.refracted
+
+
+def test_corner_normals_that_cancel_fall_back_to_the_face(yaml_scene):
+    """At x = 0 the interpolated normal of this triangle is zero: both engines shade with the
+    face normal there (the centre column of a 97-pixel image lands on it)."""
+    scene = yaml_scene("""
+        camera: {eye: [0, 0, 5], look_at: [0, 0, 0], fov: 40}
+        background: [0.2, 0.4, 0.6]
+        lights: [{position: [3, 5, 4]}]
+        objects:
+          - triangle:
+              vertices: [[-1, -1, 0], [1, -1, 0], [-1, 1, 0]]
+              normals: [[0, 0, 1], [0, 0, -1], [0, 0, 1]]
+            material: {diffuse: 0.5, transmission: 0.5, reflection: 0.25, ior: 1.0}
+        """)
+    a, b, sa, sb = both(scene, 97, 73)
+    assert np.array_equal(a, b) and sa.refracted == sb.refracted
+    assert np.isfinite(scene.objects[0].shape.normal(np.zeros((1, 3)), None)).all()

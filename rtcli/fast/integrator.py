@@ -42,8 +42,8 @@ def surface(g, k, prim, t, ox, oy, oz, dx, dy, dz):
     nx, ny, nz = gx, gy, gz
     if smooth:
         nx, ny, nz = interpolated(tri, px, py, pz)
-        if kind == MESH and not math.sqrt(nx * nx + ny * ny + nz * nz) > 0:
-            nx, ny, nz = gx, gy, gz                                   # no corner normals: the face's
+        if not math.sqrt(nx * nx + ny * ny + nz * nz) > 0:
+            nx, ny, nz = gx, gy, gz                                   # corner normals cancel: the face's
     if transformed:
         nx, ny, nz = apply(row, NRM, nx, ny, nz, 0)
         gx, gy, gz = apply(row, NRM, gx, gy, gz, 0)
@@ -197,7 +197,7 @@ def next_ray(s, f, counts):
             eta = 1.0 / ior if f[12] else ior                         # 1 -> ior entering, ior -> 1 leaving
             cos_i = -(Dx * nx + Dy * ny + Dz * nz)
             kk = 1 - eta * eta * (1 - cos_i * cos_i)
-            if kk >= 0:                                               # else total internal reflection
+            if not kk < 0:                                            # else total internal reflection
                 counts[REFRACTED] += 1
                 b = eta * cos_i - math.sqrt(max(kk, 0.0))
                 tx, ty, tz = eta * Dx + b * nx, eta * Dy + b * ny, eta * Dz + b * nz

@@ -7,8 +7,10 @@ point, spot and area lights. Anything else (CSG, torus) keeps the numpy path:
 `unsupported(scene)` names the first such thing.
 
 Geometry (`Geometry`): one row per scene object (see shapes.py for the row
-layout), the unbounded objects (planes) by index, and a BVH over the bounded
-ones. Meshes put their triangles and BVH nodes in shared arrays, polygons their
+layout); the objects tested one by one (`listed`), the unbounded ones (planes),
+with a BVH over the bounded ones; or, as the numpy core does for a scene without
+an Accelerator (fewer than 8 bounded objects), every object in file order, so
+that ties go the same way. Meshes put their triangles and BVH nodes in shared arrays, polygons their
 vertices; an object's integers say where its own start. Looks (`Looks`): the
 MaterialTable's arrays, each material's texture (image textures put their
 texels in one shared array), the lights and the scene constants.
@@ -35,7 +37,7 @@ POOL = 27                                           # pool rows: a triangle's a,
 
 # Few arrays on purpose: numba passes each array as ~8 machine words per call.
 # pool: the triangles of every mesh, then the vertices of every polygon (x, y, z in a row).
-Geometry = namedtuple("Geometry", "objects ints unbounded nodes links perm pool")
+Geometry = namedtuple("Geometry", "objects ints listed nodes links perm pool")
 # word, bits: a float64 scratch cell and its uint64 view, for hashing a float's bits (jitter).
 Looks = namedtuple("Looks", "material ka kd ks emission kr kt shininess ior shiny mirror clear "
                             "texture texels lights ambient background offset max_depth blinn word bits")
@@ -102,7 +104,9 @@ def geometry(scene) -> tuple[Geometry, int]:
     n = len(scene.objects)
     objects, ints = np.zeros((n, WIDTH)), np.zeros((n, 5), dtype=np.int64)
     boxes = scene.boxes
-    members = np.array([k for k, b in enumerate(boxes) if b is not None], dtype=np.int64)
+    tree = scene.accel is not None                   # else every object is listed, in file order
+    listed = [k for k, b in enumerate(boxes) if b is None or not tree]
+    members = np.array([k for k, b in enumerate(boxes) if b is not None and tree], dtype=np.int64)
     trees, mesh_depth = _Trees(), 0
     scene_bvh = BVH(np.array([boxes[k][0] for k in members]).reshape(-1, 3),
                     np.array([boxes[k][1] for k in members]).reshape(-1, 3), leaf_size=2)
@@ -133,8 +137,8 @@ def geometry(scene) -> tuple[Geometry, int]:
             objects[k, NRM:NRM + 12] = np.concatenate([o.world_from_object.m_inv[:3, :3].T, np.zeros((3, 1))],
                                                       axis=1).ravel()
     ints[:, CASTS] = scene.materials.shadow[[o.material for o in scene.objects]]
-    unbounded = np.array([k for k, b in enumerate(boxes) if b is None], dtype=np.int64)
-    geo = Geometry(objects, ints, unbounded, *trees.arrays(), np.ascontiguousarray(np.concatenate(pool)))
+    geo = Geometry(objects, ints, np.array(listed, dtype=np.int64), *trees.arrays(),
+                   np.ascontiguousarray(np.concatenate(pool)))
     return geo, scene_bvh.depth + mesh_depth + 4
 
 

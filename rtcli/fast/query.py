@@ -1,11 +1,13 @@
 """Ray-scene queries of the compiled path, one ray at a time (numba): the nearest hit and shadow feelers.
 
-The same questions as intersect.py asks for arrays of rays: unbounded objects
-(planes) are tested one by one, bounded ones through the scene's BVH, meshes
-through their own BVH (two levels). Each BVH is walked depth first with an
-explicit stack, pruned by the best t so far; a shadow feeler stops at its first
-blocker. Ties between objects at the very same t may go to a different object
-than the numpy path picks; nothing else differs.
+The same questions as intersect.py asks for arrays of rays: the listed objects
+(planes, or all objects of a scene without an Accelerator) are tested one by
+one, the others through the scene's BVH, meshes through their own BVH (two
+levels). Each BVH is walked depth first, nearer child first, with an explicit
+stack, pruned by the best t so far; a shadow feeler stops at its first blocker.
+A tie (two objects hit at the very same t, say coplanar faces) goes to the first
+listed object, as in the numpy core; between two objects of a BVH it may go to
+the other one than the numpy core's level-by-level walk picks.
 """
 
 from __future__ import annotations
@@ -127,8 +129,8 @@ def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
     """(t, object, prim): the nearest hit in (t_min, t_max), or with `shadow` any hit by a
     shadow-casting object; object -1 on a miss. stack: scratch for both tree levels."""
     best, obj, prim = t_max, -1, 0
-    for j in range(len(g.unbounded)):
-        k = g.unbounded[j]
+    for j in range(len(g.listed)):
+        k = g.listed[j]
         if shadow and not g.ints[k, CASTS]:
             continue
         t, p = object_hit(g, k, ox, oy, oz, dx, dy, dz, t_min, best, shadow, stack, 0)

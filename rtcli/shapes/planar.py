@@ -141,7 +141,8 @@ class Triangle:
             return self.geometric_normal(p, prim)
         alpha, beta = self.barycentric(p)
         na, nb, nc = self.normals
-        return (1 - alpha - beta)[:, None] * na + alpha[:, None] * nb + beta[:, None] * nc
+        n = (1 - alpha - beta)[:, None] * na + alpha[:, None] * nb + beta[:, None] * nc
+        return np.where(length(n)[:, None] > 0, n, self.face)       # where the corners cancel: flat
 
     def uv(self, p, prim):
         return np.stack(self.barycentric(p), axis=1)
