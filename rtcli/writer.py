@@ -43,7 +43,7 @@ def write_png(path: str, pixels: np.ndarray) -> None:
         raise RtcliError(f"cannot write {path}: {e.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as f:
-            img.save(f, format="PNG")
+            img.save(f, format="PNG", compress_level=3)  # zlib's 6 takes twice as long for 13% fewer bytes
         os.chmod(tmp, 0o666 & ~_umask())               # as a plain open() would (mkstemp makes 0600)
         os.replace(tmp, path)
     except BaseException as e:
