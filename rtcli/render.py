@@ -147,10 +147,8 @@ def _map_tiles(scene: Scene, compiled, job: Job, tiles: list, workers: int):
         for rows, cols in tiles:
             yield _run_tile(scene, compiled, job, rows, cols)
         return
-    if compiled:
-        compiled.warm_up(scene.camera(job.width, job.height))   # loaded once here, not once per worker
-    elif _uses_kernels(scene):
-        kernels.warm_up()
+    if not compiled and _uses_kernels(scene):
+        kernels.warm_up()                  # loaded once here, not once per worker (Compiled loads itself)
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
                              initargs=(scene, compiled)) as pool:

@@ -253,3 +253,13 @@ def test_corner_normals_that_cancel_fall_back_to_the_face(yaml_scene):
     a, b, sa, sb = both(scene, 97, 73)
     assert np.array_equal(a, b) and sa.refracted == sb.refracted
     assert np.isfinite(scene.objects[0].shape.normal(np.zeros((1, 3)), None)).all()
+
+
+def test_loading_the_engine_skips_numbas_blas_lookup_and_leaves_no_trace():
+    import subprocess
+    import sys
+    code = ("import sys; from rtcli.build import load_scene; from rtcli import fast; "
+            "fast.choose(load_scene('scenes/whitted.yaml'), 'compiled'); "
+            "print('scipy.linalg' in sys.modules, 'scipy.linalg.cython_blas' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["False", "False"]

@@ -19,8 +19,11 @@ AUTO_RAYS primary rays up (a 1280x800 image, or 640x480 with --samples 2).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -29,13 +32,21 @@ from rtcli.errors import RtcliError
 from rtcli.fast.pack import unsupported
 from rtcli.stats import Stats
 
+
 class Compiled:
-    """A scene packed for the compiled integrator; trace_pixels() stands in for camera rays + trace.trace."""
+    """A scene packed for the compiled integrator; trace_pixels() stands in for camera rays + trace.trace.
+
+    Making one compiles the integrator, or loads it from numba's cache, at once: worker
+    processes forked afterwards inherit the machine code."""
 
     def __init__(self, scene):
         from rtcli.fast.pack import geometry, looks
         self.geometry, stack = geometry(scene)
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
+        camera, none = SimpleNamespace(eye=np.zeros(3), origin=np.zeros(3), right=np.zeros(3), down=np.zeros(3)), \
+            np.zeros(0)
+        with _no_blas_lookup():
+            self.trace_pixels(camera, none, none, 1, 1, Stats())
 
     def trace_pixels(self, cam, x: np.ndarray, y: np.ndarray, nc: int, nr: int, stats: Stats) -> np.ndarray:
         """Colors of the camera's rays through pixel coordinates (x, y): trace(cam.rays(x, y, nc, nr))
@@ -48,10 +59,22 @@ class Compiled:
         stats.add(Stats(*(int(c) for c in counts)))
         return colors
 
-    def warm_up(self, cam) -> None:
-        """Compile, or load from the cache, now: worker processes forked later inherit the code."""
-        one = np.zeros(1)
-        self.trace_pixels(cam, one, one, 1, 1, Stats())
+
+
+@contextlib.contextmanager
+def _no_blas_lookup():
+    """numba imports scipy.linalg when it starts, ~0.2 s, to find a BLAS for np.dot in compiled code;
+    the integrator needs none, so the module numba looks for is hidden meanwhile."""
+    name = "scipy.linalg.cython_blas"
+    if name in sys.modules:
+        yield
+        return
+    sys.modules[name] = None                         # import fails at once: numba goes on without BLAS
+    try:
+        yield
+    finally:
+        if sys.modules.get(name, 0) is None:
+            del sys.modules[name]
 
 
 SOURCES = ("pack.py", "shapes.py", "query.py", "uv.py", "integrator.py")     # what the machine code is made of
