@@ -263,3 +263,16 @@ def test_loading_the_engine_skips_numbas_blas_lookup_and_leaves_no_trace():
             "print('scipy.linalg' in sys.modules, 'scipy.linalg.cython_blas' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
+
+
+def test_cli_engine_option(tmp_path):
+    from click.testing import CliRunner
+
+    from rtcli.cli import main
+    runner, out = CliRunner(), tmp_path / "out.png"
+    bad = runner.invoke(main, ["render", str(ROOT / "scenes" / "csg.yaml"), "-o", str(out), "--engine", "compiled"])
+    assert bad.exit_code == 2 and not out.exists()
+    assert "cannot render this scene: it does not handle csg objects" in bad.output
+    good = runner.invoke(main, ["render", str(ROOT / "scenes" / "whitted.yaml"), "-o", str(out), "--width", "40",
+                                "--height", "30", "--engine", "compiled", "--stats", "--workers", "1"])
+    assert good.exit_code == 0 and out.exists() and "compiled engine" in good.output
