@@ -23,13 +23,13 @@ import contextlib
 import hashlib
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 
 from rtcli import kernels
+from rtcli.camera import Camera
 from rtcli.errors import RtcliError
-from rtcli.fast.pack import unsupported
+from rtcli.fast.pack import geometry, looks, unsupported
 from rtcli.stats import Stats
 
 
@@ -40,13 +40,11 @@ class Compiled:
     processes forked afterwards inherit the machine code."""
 
     def __init__(self, scene):
-        from rtcli.fast.pack import geometry, looks
         self.geometry, stack = geometry(scene)
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
-        camera, none = SimpleNamespace(eye=np.zeros(3), origin=np.zeros(3), right=np.zeros(3), down=np.zeros(3)), \
-            np.zeros(0)
+        nowhere, none = Camera(*np.zeros((4, 3))), np.zeros(0)
         with _no_blas_lookup():
-            self.trace_pixels(camera, none, none, 1, 1, Stats())
+            self.trace_pixels(nowhere, none, none, 1, 1, Stats())        # no ray: just the machine code
 
     def trace_pixels(self, cam, x: np.ndarray, y: np.ndarray, nc: int, nr: int, stats: Stats) -> np.ndarray:
         """Colors of the camera's rays through pixel coordinates (x, y): trace(cam.rays(x, y, nc, nr))
@@ -58,7 +56,6 @@ class Compiled:
                               (cam.eye, cam.origin, cam.right, cam.down)), x, y, nc, nr, counts, self.stack)
         stats.add(Stats(*(int(c) for c in counts)))
         return colors
-
 
 
 @contextlib.contextmanager
