@@ -52,7 +52,7 @@ def main(debug):
 
 
 def _load(path, bvh=True):
-    from rtcli.build import load_scene
+    from rtcli.scenefile.build import load_scene
     return load_scene(path, bvh)
 
 
@@ -138,6 +138,7 @@ def render(scene_file, output, width, height, block_size, samples, max_depth, wo
 def signature(scene_file, output, ids_out, legend, width, height, block_size, workers):
     """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
     import numpy as np
+
     from rtcli.render import render as render_image
     from rtcli.writer import signature_colors, write_png
     scene = _load(scene_file)
@@ -208,13 +209,13 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
 @click.argument("scene_file", metavar="SCENE.yaml")
 def validate(scene_file):
     """Parse and check a scene; print a summary. Renders nothing."""
-    from rtcli.build import summary
+    from rtcli.scenefile.build import summary
     click.echo(f"{scene_file}: ok: {summary(_load(scene_file))}")
 
 
 @main.command()
 def presets():
     """List the material presets (McReynolds and Blythe) with their coefficients."""
-    from rtcli.presets import table_rows
+    from rtcli.scenefile.presets import table_rows
     for row in table_rows():
         click.echo(row)

@@ -150,6 +150,6 @@ def traverse(bvh, o, d, t_min, t_max, kind, a, b, c, any_hit=False):
 def warm_up() -> None:
     """Load (or compile) the kernel now, so worker processes forked later inherit it."""
     if available():
-        from rtcli.bvh import BVH
+        from rtcli.core.bvh import BVH
         one = np.zeros((1, 3))
         traverse(BVH(one, one + 1), one, one + 1, 0.0, np.inf, 0, one, one, one)

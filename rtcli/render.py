@@ -18,12 +18,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli import fast, kernels
-from rtcli.intersect import find_first_hit
-from rtcli.jitter import uniform
-from rtcli.scene import Scene
+from rtcli import compiled as fast
+from rtcli import kernels
+from rtcli.core.jitter import uniform
+from rtcli.core.scene import Scene
 from rtcli.stats import Stats
-from rtcli.trace import trace
+from rtcli.wavefront.intersect import find_first_hit
+from rtcli.wavefront.trace import trace
 from rtcli.writer import to_8bit
 
 TILE = 128                                 # tile edge in pixels (rays per tile: TILE^2 x samples^2)
@@ -39,7 +40,7 @@ class Job:
     tile: int = TILE
     signature: bool = False          # trace primary rays only and return object ids
     gamma: bool = False              # sRGB-encode when converting to 8 bits
-    engine: str = "auto"             # auto, numpy or compiled (see rtcli.fast.choose)
+    engine: str = "auto"             # auto, numpy or compiled (see rtcli.compiled.choose)
 
 
 def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -7,9 +7,9 @@ import textwrap
 import numpy as np
 import pytest
 
-from rtcli import yamlfile
-from rtcli.build import scene_from_docs
 from rtcli.render import Job, render_tile
+from rtcli.scenefile import yamlfile
+from rtcli.scenefile.build import scene_from_docs
 
 
 def pytest_addoption(parser):

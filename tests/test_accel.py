@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtcli.accel import Accelerator
-from rtcli.intersect import find_first_hit, occluded, surface
-from rtcli.rays import Rays
 from rtcli.render import Job, render
+from rtcli.wavefront.accel import Accelerator
+from rtcli.wavefront.intersect import find_first_hit, occluded, surface
+from rtcli.wavefront.rays import Rays
 
 
 def random_scene(yaml_scene, seed):
@@ -73,7 +73,7 @@ def test_bvh_render_is_identical(yaml_scene):
 
 def test_box_culling_keeps_edge_hits_of_flat_shapes(yaml_scene):
     """Rays aimed at a rotated square's edges hit it exactly as the shape's own test says."""
-    from rtcli.intersect import object_hit
+    from rtcli.wavefront.intersect import object_hit
     scene = yaml_scene("""
         camera: {eye: [0, 5, 0], look_at: [0, 0, 0], up: [0, 0, 1]}
         objects:

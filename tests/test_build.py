@@ -1,4 +1,4 @@
-"""Tests for rtcli.build / build_objects: scene checks with exact located messages, and what loads.
+"""Tests for rtcli.scenefile.build / build_objects: scene checks with exact located messages, and what loads.
 
 Every expected message is `scene.yaml:line:col: key.path: message`; columns are
 1-based and counted by hand (the comment under a YAML line marks the column).
@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from rtcli import camera as cameras
-from rtcli.errors import SceneError
-
 from conftest import scene_from_yaml
+
+from rtcli.core import camera as cameras
+from rtcli.errors import SceneError
 
 CAM = "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from rtcli import bvh as bvh_module
-from rtcli.bvh import BVH
+from rtcli.core import bvh as bvh_module
+from rtcli.core.bvh import BVH
 
 
 # --- primitives for the tests: spheres and closed axis-aligned boxes, as (ray, prim) pair tests ---

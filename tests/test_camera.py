@@ -1,7 +1,7 @@
 """The three camera forms of SCENE_FORMAT.md: where each pixel's ray goes.
 
 The eye-space basis is rebuilt here from the contract (w toward look_at,
-u = normalize(w x up), v = u x w) with numpy, independently of rtcli.camera.
+u = normalize(w x up), v = u x w) with numpy, independently of rtcli.core.camera.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtcli import camera as cameras
+from rtcli.core import camera as cameras
 from rtcli.errors import SceneError
 from tests.conftest import scene_from_yaml
 

@@ -6,7 +6,14 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from rtcli.compare import compare, compare_ids, compare_images, heat_map, id_boundary, read_png
+from rtcli.compare import (
+    compare,
+    compare_ids,
+    compare_images,
+    heat_map,
+    id_boundary,
+    read_png,
+)
 from rtcli.errors import RtcliError
 
 H, W = 150, 200

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rtcli.core.transform import translate
 from rtcli.errors import SceneError
 from rtcli.shapes.csg import CSG, Child
 from rtcli.shapes.sphere import Sphere
-from rtcli.transform import translate
 
 # Two unit spheres on the x axis, centres at x = 0 and x = 1: along the x axis from
 # x = -5, sphere A spans t in [4, 6] and sphere B spans [5, 7].
@@ -96,7 +96,7 @@ def test_csg_shadow_sees_the_hole(yaml_scene):
                 - {sphere: {radius: 2}}
                 - {sphere: {radius: 1}}
     """)
-    from rtcli.intersect import occluded
+    from rtcli.wavefront.intersect import occluded
     inside = np.array([[0.0, 0, 0], [0.0, 0, 0]])
     lights = np.array([[0.0, 0, 0.9], [0.0, 0, 3.0]])
     np.testing.assert_array_equal(occluded(scene, inside, lights), [False, True])

@@ -10,11 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rtcli import fast, kernels
-from rtcli.accel import Accelerator
-from rtcli.build import load_scene
+from rtcli import compiled as fast
+from rtcli import kernels
 from rtcli.errors import RtcliError
 from rtcli.render import Job, render, render_tile
+from rtcli.scenefile.build import load_scene
+from rtcli.wavefront.accel import Accelerator
 
 pytestmark = pytest.mark.skipif(not kernels.ENABLED, reason="numba is not installed")
 
@@ -258,7 +259,7 @@ def test_corner_normals_that_cancel_fall_back_to_the_face(yaml_scene):
 def test_loading_the_engine_skips_numbas_blas_lookup_and_leaves_no_trace():
     import subprocess
     import sys
-    code = ("import sys; from rtcli.build import load_scene; from rtcli import fast; "
+    code = ("import sys; from rtcli.scenefile.build import load_scene; from rtcli import compiled as fast; "
             "fast.choose(load_scene('scenes/whitted.yaml'), 'compiled'); "
             "print('scipy.linalg' in sys.modules, 'scipy.linalg.cython_blas' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)

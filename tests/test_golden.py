@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 
 from rtcli import compare
-from rtcli.build import load_scene
 from rtcli.render import Job, render
+from rtcli.scenefile.build import load_scene
 from rtcli.writer import signature_colors, write_png
 
 ROOT = Path(__file__).resolve().parent.parent

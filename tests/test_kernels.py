@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from rtcli import kernels
-from rtcli.accel import Accelerator
-from rtcli.intersect import find_first_hit, occluded
-from rtcli.rays import Rays
 from rtcli.shapes.mesh import Mesh
+from rtcli.wavefront.accel import Accelerator
+from rtcli.wavefront.intersect import find_first_hit, occluded
+from rtcli.wavefront.rays import Rays
 
 N = 2000 if kernels.ENABLED else 150
 

@@ -6,13 +6,13 @@ import pickle
 import numpy as np
 import pytest
 
+from rtcli.core.vec import normalize
 from rtcli.errors import SceneError
-from rtcli.obj import parse_obj, read_obj
-from rtcli.params import Params
+from rtcli.scenefile.obj import parse_obj, read_obj
+from rtcli.scenefile.params import Params
+from rtcli.scenefile.yamlfile import parse
 from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.planar import Triangle
-from rtcli.vec import normalize
-from rtcli.yamlfile import parse
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 MODELS = "/work/shared/models"

@@ -1,10 +1,10 @@
-"""Tests for rtcli.presets, the McReynolds/Blythe material table."""
+"""Tests for rtcli.scenefile.presets, the McReynolds/Blythe material table."""
 
 import dataclasses
 
 import pytest
 
-from rtcli.presets import PRESETS, Preset, preset, table_rows
+from rtcli.scenefile.presets import PRESETS, Preset, preset, table_rows
 
 NAMES = [
     "brass", "bronze", "polished_bronze", "chrome", "copper", "polished_copper",

@@ -103,7 +103,7 @@ def test_a_pixel_is_the_mean_of_its_samples():
     """With samples n, a pixel's float color is the mean of the n x n rays traced at sample_positions."""
     from rtcli.render import render_tile
     from rtcli.stats import Stats
-    from rtcli.trace import trace
+    from rtcli.wavefront.trace import trace
     scene2 = scene_from_yaml(SCENE.format(samples=2))
     i, j = np.array([3, 11, 20, 7]), np.array([2, 8, 15, 12])
     colors, _ = render_tile(scene2, Job(W, H), i, j)

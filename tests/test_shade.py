@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.intersect import find_first_hit
+from rtcli.wavefront.intersect import find_first_hit
 from tests.conftest import one_pixel, scene_from_yaml
 
 RTOL = 1e-9

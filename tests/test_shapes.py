@@ -2,7 +2,7 @@
 
 Analytic hits, misses are inf, t_min < t < t_max, batch == one ray at a time
 (exact), unit outward normals under random transforms (mirrors included), and
-pbrt's re-intersection test: rays spawned from a hit as rtcli.trace spawns them
+pbrt's re-intersection test: rays spawned from a hit as rtcli.wavefront.trace spawns them
 never hit the same surface again right away.
 """
 
@@ -11,13 +11,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtcli import transform as tf
-from rtcli.intersect import find_first_hit, surface
-from rtcli.materials import Material, MaterialTable
-from rtcli.rays import Rays
-from rtcli.scene import Scene, SceneObject
+from rtcli.core import transform as tf
+from rtcli.core.materials import Material, MaterialTable
+from rtcli.core.scene import Scene, SceneObject
 from rtcli.shapes.planar import Plane, Polygon, Square, Triangle
 from rtcli.shapes.sphere import Sphere
+from rtcli.wavefront.intersect import find_first_hit, surface
+from rtcli.wavefront.rays import Rays
 
 
 def _star():
@@ -308,7 +308,7 @@ def test_normals_under_random_transforms_are_unit_and_face_the_ray(name):
 
 def spawn(s: Scene, p, ng, rng):
     """Random unit directions on ng's side (the side the ray came from), starting where
-    rtcli.trace starts a mirror ray: p + offset * ng."""
+    rtcli.wavefront.trace starts a mirror ray: p + offset * ng."""
     w = rng.normal(size=p.shape)
     w /= np.linalg.norm(w, axis=1)[:, None]
     w = np.where((np.sum(w * ng, axis=1) < 0)[:, None], -w, w)

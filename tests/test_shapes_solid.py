@@ -9,9 +9,9 @@ messages of from_params.
 import numpy as np
 import pytest
 
-from rtcli import yamlfile
 from rtcli.errors import SceneError
-from rtcli.params import Params
+from rtcli.scenefile import yamlfile
+from rtcli.scenefile.params import Params
 from rtcli.shapes.box import Box
 from rtcli.shapes.quadric import Cone, Cylinder
 from rtcli.shapes.torus import Torus

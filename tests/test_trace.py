@@ -1,5 +1,5 @@
 """The global terms of the shading equation: kr * trace(mirror ray), kt * trace(refracted ray),
-max_depth, total internal reflection, and Snell's law in rtcli.vec.refract.
+max_depth, total internal reflection, and Snell's law in rtcli.core.vec.refract.
 
 Mirrors and glass here have no local term (ka = kd = ks = 0), and what they show
 is an emission-only target, so each pixel is an exact product of weights and
@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtcli.intersect import find_first_hit, surface
-from rtcli.rays import Rays
-from rtcli.vec import refract
+from rtcli.core.vec import refract
+from rtcli.wavefront.intersect import find_first_hit, surface
+from rtcli.wavefront.rays import Rays
 from tests.conftest import one_pixel, scene_from_yaml
 
 RTOL = 1e-9
@@ -208,7 +208,7 @@ def test_total_internal_reflection_has_no_refracted_term(theta):
     np.testing.assert_array_equal(one_pixel(s), [0, 0, 0])
 
 
-# --- rtcli.vec.refract directly ---
+# --- rtcli.core.vec.refract directly ---
 def frames(k: int, seed: int):
     """k random orthonormal pairs (n, tangent)."""
     rng = np.random.default_rng(seed)

@@ -1,13 +1,13 @@
-"""rtcli.vec (normalize, reflect) and rtcli.transform (composition order, normals, singular matrices)."""
+"""rtcli.core.vec (normalize, reflect) and rtcli.core.transform (composition order, normals, singular matrices)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from rtcli import transform as tf
+from rtcli.core import transform as tf
+from rtcli.core.vec import cross, dot, normalize, reflect
 from rtcli.errors import SceneError
-from rtcli.vec import cross, dot, normalize, reflect
 from tests.conftest import scene_from_yaml
 
 RNG = np.random.default_rng(42)

@@ -1,4 +1,4 @@
-"""Tests for rtcli.yamlfile: located YAML loading, anchors, merge keys, includes.
+"""Tests for rtcli.scenefile.yamlfile: located YAML loading, anchors, merge keys, includes.
 
 Columns in comments are 1-based and were counted by hand.
 """
@@ -7,11 +7,10 @@ from __future__ import annotations
 
 import pytest
 import yaml
-
-from rtcli import yamlfile
-from rtcli.errors import SceneError
-
 from conftest import scene_from_yaml
+
+from rtcli.errors import SceneError
+from rtcli.scenefile import yamlfile
 
 CAM = "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
 LIBYAML = hasattr(yaml, "CSafeLoader")       # yamlfile uses libyaml's parser when present

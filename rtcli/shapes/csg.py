@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.transform import Transform, outer_bounds, ray_into
+from rtcli.core.transform import Transform, outer_bounds, ray_into
 
 OPS = ("union", "intersection", "difference")
 
@@ -39,7 +39,7 @@ def csg_from(p, builder, material: int) -> "CSG":
     ops = [k for k in OPS if p.has(k)]
     if len(ops) != 1:
         raise p.error(None, "a csg needs exactly one of: union, intersection, difference")
-    from rtcli.params import as_params
+    from rtcli.scenefile.params import as_params
     items = p.items(ops[0])
     if len(items) < 2:
         raise p.error(ops[0], f"needs at least 2 objects, got {len(items)}")

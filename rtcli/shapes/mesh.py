@@ -21,10 +21,10 @@ import os
 import numpy as np
 
 from rtcli import kernels
-from rtcli.bvh import BVH
-from rtcli.obj import read_obj
+from rtcli.core.bvh import BVH
+from rtcli.core.vec import cross, length
+from rtcli.scenefile.obj import read_obj
 from rtcli.shapes.planar import barycentric, degenerate, triangle_solve
-from rtcli.vec import cross, length
 
 
 class Mesh:

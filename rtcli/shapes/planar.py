@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.vec import cross, dot, length, normalize
+from rtcli.core.vec import cross, dot, length, normalize
 
 
 def _plane_t(o, d, point, n, t_min, t_max):

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.vec import cross, dot, normalize
+from rtcli.core.vec import cross, dot, normalize
 
 _PRIM = np.array([0, 0, 1, 2])                          # candidates: wall root 1, 2, base, top
 

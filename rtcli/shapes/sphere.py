@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.vec import dot
+from rtcli.core.vec import dot
 
 
 def sphere_roots(S, d, r2):

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.vec import dot, length
+from rtcli.core.vec import dot, length
 
 
 def _largest_cubic_root(A, B, C):

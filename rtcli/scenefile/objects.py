@@ -12,14 +12,14 @@ import os
 import numpy as np
 from PIL import Image, UnidentifiedImageError
 
-from rtcli import transform as tf
+from rtcli.core import transform as tf
+from rtcli.core.materials import Material
+from rtcli.core.scene import SceneObject
+from rtcli.core.textures import Checker, ImageTexture
 from rtcli.errors import SceneError
-from rtcli.materials import Material
-from rtcli.params import Params, as_params, describe
-from rtcli.presets import PRESETS
-from rtcli.scene import SceneObject
+from rtcli.scenefile.params import Params, as_params, describe
+from rtcli.scenefile.presets import PRESETS
 from rtcli.shapes import SHAPES
-from rtcli.textures import Checker, ImageTexture
 
 OBJECT_KINDS = tuple(SHAPES) + ("csg", "group")
 

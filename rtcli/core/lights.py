@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.jitter import uniform
-from rtcli.vec import dot
+from rtcli.core.jitter import uniform
+from rtcli.core.vec import dot
 
 
 @dataclass(frozen=True)

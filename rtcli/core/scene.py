@@ -7,9 +7,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli.bvh import padded
-from rtcli.materials import MaterialTable
-from rtcli.transform import Transform, outer_bounds, ray_into
+from rtcli.core.bvh import padded
+from rtcli.core.materials import MaterialTable
+from rtcli.core.transform import Transform, outer_bounds, ray_into
 
 
 @dataclass
@@ -50,7 +50,7 @@ class Scene:
     ambient: np.ndarray = field(default_factory=lambda: np.full(3, 0.1))      # Ia
     settings: Settings = field(default_factory=Settings)
     eye: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    accel: object = None             # rtcli.accel.Accelerator, built by prepare()
+    accel: object = None             # rtcli.wavefront.accel.Accelerator, built by prepare()
 
     @functools.cached_property
     def boxes(self) -> list:

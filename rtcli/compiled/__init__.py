@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from rtcli import kernels
-from rtcli.camera import Camera
+from rtcli.compiled.pack import geometry, looks, unsupported
+from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
-from rtcli.fast.pack import geometry, looks, unsupported
 from rtcli.stats import Stats
 
 
@@ -49,7 +49,7 @@ class Compiled:
     def trace_pixels(self, cam, x: np.ndarray, y: np.ndarray, nc: int, nr: int, stats: Stats) -> np.ndarray:
         """Colors of the camera's rays through pixel coordinates (x, y): trace(cam.rays(x, y, nc, nr))
         without building the rays in numpy."""
-        from rtcli.fast.integrator import trace_camera
+        from rtcli.compiled.integrator import trace_camera
         counts = np.zeros(4, dtype=np.int64)
         x, y = (np.ascontiguousarray(v, dtype=float) for v in (x, y))
         colors = trace_camera(self.geometry, self.looks, *(np.asarray(v, dtype=float) for v in
@@ -102,7 +102,7 @@ def _load() -> str | None:
         return "numba is not installed (pip install 'rtcli[fast]')"
     _drop_stale_cache()
     try:
-        import rtcli.fast.integrator  # noqa: F401
+        import rtcli.compiled.integrator  # noqa: F401
     except ImportError as e:
         return f"numba cannot be loaded ({e})"
     return None

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from rtcli.errors import SceneError, Where
-from rtcli.yamlfile import MapNode, SeqNode
+from rtcli.scenefile.yamlfile import MapNode, SeqNode
 
 REQUIRED = object()
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.bvh_build import build
+from rtcli.core.bvh_build import build
 
 CHUNK = 1 << 13                         # rays traversed together
 PAD = 1e-9                              # boxes grow by PAD x their largest |coordinate|, so rounding in

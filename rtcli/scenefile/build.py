@@ -10,14 +10,14 @@ import functools
 
 import numpy as np
 
-from rtcli import camera as cameras
-from rtcli import yamlfile
-from rtcli.accel import Accelerator
-from rtcli.build_objects import ObjectBuilder, material_from
-from rtcli.lights import PointLight
-from rtcli.materials import Material, MaterialTable
-from rtcli.params import Params, as_params
-from rtcli.scene import Scene, Settings
+from rtcli.core import camera as cameras
+from rtcli.core.lights import PointLight
+from rtcli.core.materials import Material, MaterialTable
+from rtcli.core.scene import Scene, Settings
+from rtcli.scenefile import yamlfile
+from rtcli.scenefile.objects import ObjectBuilder, material_from
+from rtcli.scenefile.params import Params, as_params
+from rtcli.wavefront.accel import Accelerator
 
 MAX_SIZE = 32768
 

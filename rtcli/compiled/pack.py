@@ -22,13 +22,13 @@ from collections import namedtuple
 
 import numpy as np
 
-from rtcli.bvh import BVH
+from rtcli.core.bvh import BVH
+from rtcli.core.textures import Checker, ImageTexture
 from rtcli.shapes.box import Box
 from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.planar import Plane, Polygon, Square, Triangle
 from rtcli.shapes.quadric import _Tapered
 from rtcli.shapes.sphere import Sphere
-from rtcli.textures import Checker, ImageTexture
 
 SPHERE, PLANE, BOX, TAPERED, TRIANGLE, SQUARE, MESH, POLYGON = range(8)    # shape kinds, as in shapes.py
 INV, NRM, WIDTH = 24, 36, 48                        # columns of an object row: parameters, object_from_world, A^-T

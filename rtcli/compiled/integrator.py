@@ -17,10 +17,10 @@ import math
 
 import numpy as np
 
-from rtcli.fast.pack import IMAGE, KIND, MESH, NO_TEXTURE, NRM, SMOOTH, TRIANGLE, XF
-from rtcli.fast.query import object_ray, scene_hit
-from rtcli.fast.shapes import apply, entry, inline, interpolated, jit, normal
-from rtcli.fast.uv import image, uv
+from rtcli.compiled.pack import IMAGE, KIND, MESH, NO_TEXTURE, NRM, SMOOTH, TRIANGLE, XF
+from rtcli.compiled.query import object_ray, scene_hit
+from rtcli.compiled.shapes import apply, entry, inline, interpolated, jit, normal
+from rtcli.compiled.uv import image, uv
 
 SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
 

@@ -12,9 +12,15 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli import kernels
-from rtcli.bvh import BVH
-from rtcli.intersect import blocked_by, blocks, nearest_over, no_hits, object_hit
+from rtcli.core.bvh import BVH
 from rtcli.shapes.sphere import Sphere, nearest_root, sphere_roots
+from rtcli.wavefront.intersect import (
+    blocked_by,
+    blocks,
+    nearest_over,
+    no_hits,
+    object_hit,
+)
 
 MIN_OBJECTS = 8            # below this many bounded objects the plain loop is faster
 

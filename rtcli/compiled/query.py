@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-from rtcli.fast.pack import CASTS, INV, KIND, MESH, POLYGON, ROOT, XF
-from rtcli.fast.shapes import apply, hit, inline, jit, plane, triangle
+from rtcli.compiled.pack import CASTS, INV, KIND, MESH, POLYGON, ROOT, XF
+from rtcli.compiled.shapes import apply, hit, inline, jit, plane, triangle
 
 
 @jit

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.intersect import Surface, occluded
-from rtcli.rays import Rays
-from rtcli.scene import Scene
+from rtcli.core.scene import Scene
+from rtcli.core.vec import dot, normalize
 from rtcli.stats import Stats
-from rtcli.vec import dot, normalize
+from rtcli.wavefront.intersect import Surface, occluded
+from rtcli.wavefront.rays import Rays
 
 
 def specular(N, L, V, NL, NV, n, model: str) -> np.ndarray:

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.rays import Rays
-from rtcli.vec import cross, normalize
+from rtcli.core.vec import cross, normalize
+from rtcli.wavefront.rays import Rays
 
 
 def eye_basis(eye, look_at, up) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

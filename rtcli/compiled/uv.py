@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from rtcli.fast.pack import BOX, MESH, PLANE, POLYGON, SPHERE, SQUARE, TAPERED
-from rtcli.fast.shapes import barycentric, corners, jit, local
+from rtcli.compiled.pack import BOX, MESH, PLANE, POLYGON, SPHERE, SQUARE, TAPERED
+from rtcli.compiled.shapes import barycentric, corners, jit, local
 
 
 @jit

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.intersect import find_first_hit, surface
-from rtcli.rays import Rays
-from rtcli.scene import Scene
-from rtcli.shade import local
+from rtcli.core.scene import Scene
+from rtcli.core.vec import normalize, reflect, refract
 from rtcli.stats import Stats
-from rtcli.vec import normalize, reflect, refract
+from rtcli.wavefront.intersect import find_first_hit, surface
+from rtcli.wavefront.rays import Rays
+from rtcli.wavefront.shade import local
 
 
 def trace(scene: Scene, rays: Rays, depth: int, stats: Stats) -> np.ndarray:

@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rtcli.fast.pack import BOX, PLANE, POLYGON, SPHERE, SQUARE, TAPERED, TRIANGLE
+from rtcli.compiled.pack import BOX, PLANE, POLYGON, SPHERE, SQUARE, TAPERED, TRIANGLE
 
 # How the compiled engine's functions are built (measured on whitted at 960x540, ns per pixel):
 # - error_model="numpy": x / 0 gives inf or nan, as in the numpy core, instead of raising.

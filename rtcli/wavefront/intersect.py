@@ -12,11 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.bvh import columns, slab
-from rtcli.rays import Rays
-from rtcli.scene import Scene
+from rtcli.core.bvh import columns, slab
+from rtcli.core.scene import Scene
+from rtcli.core.vec import dot, normalize
 from rtcli.shapes.sphere import sphere_uv
-from rtcli.vec import dot, normalize
+from rtcli.wavefront.rays import Rays
 
 
 @dataclass(frozen=True)
