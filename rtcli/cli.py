@@ -1,4 +1,4 @@
-"""The rtcli command line (CLI.md): render, signature, compare, validate, presets.
+"""The rtcli command line (README.md, Commands): render, signature, compare, validate, presets.
 
 Argument handling only. Errors from the library (RtcliError) and usage errors
 become one `error: ...` line on stderr with exit code 2; `--debug` shows the
@@ -51,9 +51,9 @@ def main(debug):
     # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
-def _load(path, bvh=True):
+def _load(path):
     from rtcli.scenefile.build import load_scene
-    return load_scene(path, bvh)
+    return load_scene(path)
 
 
 def _output(scene_path: str, out: str | None, suffix: str = ".png") -> str:
@@ -106,7 +106,7 @@ def render(scene_file, output, width, height, block_size, samples, max_depth, wo
     from rtcli.render import render as render_image
     from rtcli.writer import write_png
     start = time.perf_counter()
-    scene = _load(scene_file, not no_bvh)
+    scene = _load(scene_file)
     out = _output(scene_file, output)
     if samples:
         scene.settings.samples = samples
@@ -114,7 +114,7 @@ def render(scene_file, output, width, height, block_size, samples, max_depth, wo
         scene.settings.max_depth = max_depth
     if no_bvh and engine == "auto":
         engine = "numpy"                   # brute force is a numpy-engine comparison
-    job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine)
+    job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine, bvh=not no_bvh)
     show = _progress(not quiet and (progress or sys.stderr.isatty()), os.path.basename(scene_file))
     image, counts = render_image(scene, job, workers or os.cpu_count() or 1, show)
     write_png(out, image)

@@ -6,7 +6,7 @@ every pixel's value depends only on the pixel (jitter is hashed from its
 coordinates), so the image is the same for any tile size and worker count.
 With `block_size` B, one ray goes through the top-left pixel of each B x B block
 and the whole block gets its color (002's raytrace loop). Job.engine picks the
-numpy core or the compiled integrator (rtcli/fast/) to trace the primary rays.
+numpy engine (rtcli/wavefront/) or the compiled one (rtcli/compiled/) to trace the rays.
 """
 
 from __future__ import annotations
@@ -18,12 +18,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli import compiled as fast
-from rtcli import kernels
-from rtcli.core.jitter import uniform
+from rtcli import compiled, wavefront
+from rtcli.core.camera import primary_ray
+from rtcli.core.jitter import hash_pixel
 from rtcli.core.scene import Scene
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
+from rtcli.wavefront.rays import Rays
 from rtcli.wavefront.trace import trace
 from rtcli.writer import to_8bit
 
@@ -41,6 +42,7 @@ class Job:
     signature: bool = False          # trace primary rays only and return object ids
     gamma: bool = False              # sRGB-encode when converting to 8 bits
     engine: str = "auto"             # auto, numpy or compiled (see rtcli.compiled.choose)
+    bvh: bool = True                 # numpy engine: a BVH over scenes of many objects
 
 
 def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -53,29 +55,36 @@ def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, 
     xs, ys = [], []
     for cell in range(n * n):
         a, b = divmod(cell, n)
-        xs.append(i + (b + uniform(i, j, cell, 0)) / n)
-        ys.append(j + (a + uniform(i, j, cell, 1)) / n)
+        xs.append(i + (b + hash_pixel(i, j, cell, 0)) / n)
+        ys.append(j + (a + hash_pixel(i, j, cell, 1)) / n)
     return np.array(xs), np.array(ys)
 
 
+def camera_rays(cam, x, y, nc: int, nr: int) -> Rays:
+    """The camera's rays through pixel coordinates (x, y) (n,) of an nc x nr image."""
+    ox, oy, oz, *d = primary_ray(cam.row, x, y, nc, nr)
+    return Rays(np.repeat(np.array([[ox], [oy], [oz]]), len(x), axis=1), np.array(d))
+
+
 def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
-                compiled: fast.Compiled | None = None) -> tuple[np.ndarray, Stats]:
-    """Colors (or ids) of the pixels (i, j) of the full-size image; `compiled` traces
-    them instead of the numpy core when given."""
+                engine: compiled.Compiled | None = None) -> tuple[np.ndarray, Stats]:
+    """Colors (or ids) of the pixels (i, j) of the full-size image; a compiled `engine` traces
+    them instead of the numpy engine when given."""
     stats = Stats()
     cam = scene.camera(job.width, job.height)
     if job.signature:
-        rays = cam.rays(i + 0.5, j + 0.5, job.width, job.height)
+        rays = camera_rays(cam, i + 0.5, j + 0.5, job.width, job.height)
         hits = find_first_hit(scene, rays)
         stats.primary += len(rays)
         ids = np.array([o.id for o in scene.objects] + [0], dtype=np.uint16)
         return ids[hits.obj], stats
     xs, ys = sample_positions(i, j, scene.settings.samples)
     stats.primary += xs.size
-    if compiled:
-        colors = compiled.trace_pixels(cam, xs.ravel(), ys.ravel(), job.width, job.height, stats)
+    if engine:
+        colors = engine.trace_pixels(cam, xs.ravel(), ys.ravel(), job.width, job.height, stats)
     else:
-        colors = trace(scene, cam.rays(xs.ravel(), ys.ravel(), job.width, job.height), 1, stats)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            colors = trace(scene, camera_rays(cam, xs.ravel(), ys.ravel(), job.width, job.height), 1, stats).T
     colors = colors.reshape(len(xs), len(i), 3)
     return colors.mean(axis=0), stats
 
@@ -93,10 +102,10 @@ def _tiles(job: Job, samples: int = 1):
             yield rows[r:r + edge], cols[c:c + edge]
 
 
-def _run_tile(scene: Scene, compiled, job: Job, rows: np.ndarray, cols: np.ndarray):
+def _run_tile(scene: Scene, engine, job: Job, rows: np.ndarray, cols: np.ndarray):
     """A tile's 8-bit pixels (or ids), small enough to pile up while the parent catches up."""
     jj, ii = np.meshgrid(rows, cols, indexing="ij")
-    values, stats = render_tile(scene, job, ii.ravel(), jj.ravel(), compiled)
+    values, stats = render_tile(scene, job, ii.ravel(), jj.ravel(), engine)
     if not job.signature:
         values = to_8bit(values, job.gamma)
     return rows, cols, values.reshape(len(rows), len(cols), *values.shape[1:]), stats
@@ -105,9 +114,9 @@ def _run_tile(scene: Scene, compiled, job: Job, rows: np.ndarray, cols: np.ndarr
 _worker_scene = (None, None)               # the scene and its compiled form, sent once to each worker
 
 
-def _init_worker(scene: Scene, compiled) -> None:
+def _init_worker(scene: Scene, engine) -> None:
     global _worker_scene
-    _worker_scene = (scene, compiled)
+    _worker_scene = (scene, engine)
 
 
 def _worker_tile(job: Job, rows, cols):
@@ -125,9 +134,11 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     image = np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
     stats, tiles = Stats(), list(_tiles(job, 1 if job.signature else scene.settings.samples))
     traced = sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
-    compiled = None if job.signature else fast.choose(scene, job.engine, traced)
-    stats.engine = "compiled" if compiled else "numpy"          # add() keeps it
-    for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, compiled, job, tiles, workers), 1):
+    engine = None if job.signature else compiled.choose(scene, job.engine, traced)
+    if not engine:
+        wavefront.prepare(scene, job.bvh)
+    stats.engine = "compiled" if engine else "numpy"            # add() keeps it
+    for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, engine, job, tiles, workers), 1):
         block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
         image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
         stats.add(s)
@@ -136,23 +147,14 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     return image, stats
 
 
-def _uses_kernels(scene: Scene) -> bool:
-    """Whether tracing this scene calls the compiled traversal (meshes, sets of spheres)."""
-    from rtcli.shapes.mesh import Mesh
-    return (any(isinstance(o.shape, Mesh) for o in scene.objects)
-            or (scene.accel is not None and scene.accel.all_spheres))
-
-
-def _map_tiles(scene: Scene, compiled, job: Job, tiles: list, workers: int):
+def _map_tiles(scene: Scene, engine, job: Job, tiles: list, workers: int):
     if workers <= 1 or len(tiles) == 1:
         for rows, cols in tiles:
-            yield _run_tile(scene, compiled, job, rows, cols)
+            yield _run_tile(scene, engine, job, rows, cols)
         return
-    if not compiled and _uses_kernels(scene):
-        kernels.warm_up()                  # loaded once here, not once per worker (Compiled loads itself)
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
-                             initargs=(scene, compiled)) as pool:
+                             initargs=(scene, engine)) as pool:
         futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
         for f in as_completed(futures):
             yield f.result()

@@ -36,7 +36,7 @@ def test_bvh_first_hit_equals_brute_force(yaml_scene, seed):
     """Same t, object and primitive for every ray, with and without the BVH."""
     scene = random_scene(yaml_scene, seed)
     rng = np.random.default_rng(seed + 10)
-    rays = Rays(rng.normal(size=(3000, 3)) * 6, rng.normal(size=(3000, 3)))
+    rays = Rays.from_rows(rng.normal(size=(3000, 3)) * 6, rng.normal(size=(3000, 3)))
     brute = find_first_hit(scene, rays)
     scene.accel = Accelerator(scene)
     fast = find_first_hit(scene, rays)
@@ -50,8 +50,8 @@ def test_bvh_shadow_feelers_and_surfaces_equal_brute_force(yaml_scene):
     """Shadow feelers (honouring shadow: false) and surface records agree with brute force."""
     scene = random_scene(yaml_scene, 3)
     rng = np.random.default_rng(5)
-    p, light = rng.normal(size=(3000, 3)) * 5, rng.normal(size=(3000, 3)) * 5
-    rays = Rays(rng.normal(size=(2000, 3)) * 6, rng.normal(size=(2000, 3)))
+    p, light = rng.normal(size=(3, 3000)) * 5, rng.normal(size=(3, 3000)) * 5      # components
+    rays = Rays.from_rows(rng.normal(size=(2000, 3)) * 6, rng.normal(size=(2000, 3)))
     brute_blocked, hits = occluded(scene, p, light), find_first_hit(scene, rays)
     seen = np.isfinite(hits.t)
     brute_surface = surface(scene, rays[seen], hits[seen])
@@ -85,7 +85,7 @@ def test_box_culling_keeps_edge_hits_of_flat_shapes(yaml_scene):
     target = np.where(rng.integers(0, 2, 20000)[:, None] == 1, np.stack([edge, side], 1), np.stack([side, edge], 1))
     points = np.stack([target[:, 0] + 0.1, np.full(20000, 0.7), target[:, 1] + 0.3], 1)
     o = points + rng.normal(size=(20000, 3)) * [1, 0, 1] + [0, 4, 0]
-    rays = Rays(o, points - o)
-    direct, _ = object_hit(scene.objects[0], rays.origin, rays.direction, 0.0, np.inf)
+    rays = Rays.from_rows(o, points - o)
+    direct, _ = object_hit(scene.objects[0], rays.o, rays.d, 0.0, np.inf)
     assert np.isfinite(direct).sum() > 1000
     np.testing.assert_array_equal(find_first_hit(scene, rays).t, direct)

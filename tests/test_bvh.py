@@ -43,7 +43,7 @@ def brute_force(m, n, hit_pairs, t_max):
 
 
 def check_nearest(bvh, o, d, t_min, t_max, hit_pairs):
-    t, prim = bvh.intersect(o, d, t_min, t_max, hit_pairs)
+    t, prim = bvh.intersect(o.T.copy(), d.T.copy(), t_min, t_max, hit_pairs)       # rays as components
     all_t = brute_force(bvh.m, len(o), hit_pairs, t_max)
     expected = all_t.min(axis=1)
     np.testing.assert_array_equal(t, expected)
@@ -111,21 +111,21 @@ def test_t_min_and_t_max_arrays(rng):
 def test_many_identical_boxes_are_halved_by_count(rng):
     lo, hi = np.zeros((50, 3)), np.ones((50, 3))
     bvh = BVH(lo, hi, leaf_size=4)
-    assert bvh.count.max() <= 4
+    assert bvh.links[:, 2].max() <= 4
     o, d = random_rays(rng, 300, spread=2)
     check_nearest(bvh, o, d, 0.0, np.inf, box_pairs(lo, hi, o, d, 0.0))
 
 
 def test_no_primitives():
     bvh = BVH(np.zeros((0, 3)), np.zeros((0, 3)))
-    t, prim = bvh.intersect(np.zeros((2, 3)), np.ones((2, 3)), 0, np.inf, None)
+    t, prim = bvh.intersect(np.zeros((3, 2)), np.ones((3, 2)), 0, np.inf, None)
     assert np.all(np.isinf(t)) and np.all(prim == -1)
-    assert not bvh.any_hit(np.zeros((2, 3)), np.ones((2, 3)), 0, np.inf, None).any()
+    assert not bvh.any_hit(np.zeros((3, 2)), np.ones((3, 2)), 0, np.inf, None).any()
 
 
 def test_no_rays(rng):
     bvh = BVH(np.zeros((3, 3)), np.ones((3, 3)))
-    t, prim = bvh.intersect(np.zeros((0, 3)), np.zeros((0, 3)), 0, np.inf, None)
+    t, prim = bvh.intersect(np.zeros((3, 0)), np.zeros((3, 0)), 0, np.inf, None)
     assert t.shape == (0,) and prim.shape == (0,)
 
 
@@ -136,7 +136,7 @@ def test_any_hit_equals_brute_force(rng):
     o, d = random_rays(rng, 3000)
     t_max = rng.uniform(0, 2, 3000)
     hit_pairs = sphere_pairs(center, radius, o, d, 1e-6)
-    blocked = bvh.any_hit(o, d, 1e-6, t_max, hit_pairs)
+    blocked = bvh.any_hit(o.T.copy(), d.T.copy(), 1e-6, t_max, hit_pairs)
     expected = np.isfinite(brute_force(300, 3000, hit_pairs, t_max).min(axis=1))
     np.testing.assert_array_equal(blocked, expected)
     assert 0.1 < blocked.mean() < 0.9
@@ -148,14 +148,16 @@ def test_tree_is_consistent(rng):
     hi = lo + rng.uniform(0, 0.1, (1000, 3))
     bvh = BVH(lo, hi, leaf_size=4)
     np.testing.assert_array_equal(np.sort(bvh.perm), np.arange(1000))
-    leaf = bvh.child < 0
-    assert bvh.count[leaf].min() >= 1 and bvh.count[leaf].max() <= 4 and bvh.count[leaf].sum() == 1000
+    child, start, count = bvh.links.T
+    box_lo, box_hi = bvh.nodes[:, :3], bvh.nodes[:, 3:]
+    leaf = child < 0
+    assert count[leaf].min() >= 1 and count[leaf].max() <= 4 and count[leaf].sum() == 1000
     for k in np.flatnonzero(~leaf):                             # children inside their parent
-        for c in (bvh.child[k], bvh.child[k] + 1):
-            assert np.all(bvh.lo[:, c] >= bvh.lo[:, k]) and np.all(bvh.hi[:, c] <= bvh.hi[:, k])
+        for c in (child[k], child[k] + 1):
+            assert np.all(box_lo[c] >= box_lo[k]) and np.all(box_hi[c] <= box_hi[k])
     for k in np.flatnonzero(leaf):                              # primitives inside their leaf
-        p = bvh.perm[bvh.start[k]:bvh.start[k] + bvh.count[k]]
-        assert np.all(lo[p] >= bvh.lo[:, k]) and np.all(hi[p] <= bvh.hi[:, k])
+        p = bvh.perm[start[k]:start[k] + count[k]]
+        assert np.all(lo[p] >= box_lo[k]) and np.all(hi[p] <= box_hi[k])
     b_lo, b_hi = bvh.bounds()
     np.testing.assert_array_equal(b_lo, lo.min(axis=0))
     np.testing.assert_array_equal(b_hi, hi.max(axis=0))
@@ -164,5 +166,5 @@ def test_tree_is_consistent(rng):
 def test_sah_separates_two_clusters(rng):
     lo = np.concatenate([rng.uniform(0, 1, (64, 3)), rng.uniform(10, 11, (64, 3))])
     bvh = BVH(lo, lo + 0.01)
-    left, right = bvh.child[0], bvh.child[0] + 1
-    assert bvh.hi[0, left] < 2 and bvh.lo[0, right] > 9
+    left, right = bvh.links[0, 0], bvh.links[0, 0] + 1
+    assert bvh.nodes[left, 3] < 2 and bvh.nodes[right, 0] > 9

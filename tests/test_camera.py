@@ -11,6 +11,7 @@ import pytest
 
 from rtcli.core import camera as cameras
 from rtcli.errors import SceneError
+from rtcli.render import camera_rays
 from tests.conftest import scene_from_yaml
 
 EYE, LOOK, UP = np.array([1.0, 2.0, 3.0]), np.array([-2.0, 0.5, -1.0]), np.array([0.2, 1.0, 0.1])
@@ -26,8 +27,8 @@ def basis(eye, look_at, up):
 def pixel_rays(cam, nc, nr):
     """Rays through every pixel centre, row-major from the top-left pixel: (j, i, 3) origins, directions."""
     j, i = np.meshgrid(np.arange(nr), np.arange(nc), indexing="ij")
-    rays = cam.rays(i.ravel() + 0.5, j.ravel() + 0.5, nc, nr)
-    return rays.origin.reshape(nr, nc, 3), rays.direction.reshape(nr, nc, 3)
+    rays = camera_rays(cam, i.ravel() + 0.5, j.ravel() + 0.5, nc, nr)
+    return rays.o.T.reshape(nr, nc, 3), rays.d.T.reshape(nr, nc, 3)
 
 
 def unit(a):
@@ -52,7 +53,7 @@ def test_fov_is_the_vertical_angle_and_width_follows_aspect(fov, nc, nr):
     """Top/bottom edges are fov/2 from w; left/right edges atan(nc/nr tan(fov/2)) from w."""
     cam = cameras.from_fov(EYE, LOOK, UP, fov, nc, nr)
     u, v, w = basis(EYE, LOOK, UP)
-    top, bottom, left, right = (cam.rays(np.array([x]), np.array([y]), nc, nr).direction[0]
+    top, bottom, left, right = (camera_rays(cam, np.array([x]), np.array([y]), nc, nr).d[:, 0]
                                 for x, y in ((nc / 2, 0), (nc / 2, nr), (0, nr / 2), (nc, nr / 2)))
     half = np.radians(fov) / 2
     for d, side, expected in ((top, v, half), (bottom, -v, half),

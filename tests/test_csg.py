@@ -99,7 +99,7 @@ def test_csg_shadow_sees_the_hole(yaml_scene):
     from rtcli.wavefront.intersect import occluded
     inside = np.array([[0.0, 0, 0], [0.0, 0, 0]])
     lights = np.array([[0.0, 0, 0.9], [0.0, 0, 3.0]])
-    np.testing.assert_array_equal(occluded(scene, inside, lights), [False, True])
+    np.testing.assert_array_equal(occluded(scene, inside.T, lights.T), [False, True])   # components (3, n)
 
 
 def test_csg_of_a_triangle_is_an_error(yaml_scene):

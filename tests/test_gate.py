@@ -57,7 +57,9 @@ def test_fails_on_a_flipped_normal(yaml_scene, monkeypatch):
     """A sphere normal pointing inward (entering and leaving swapped in refraction) fails."""
     from rtcli.shapes.sphere import Sphere
     good = rendered(yaml_scene, extra=GLASS)
-    monkeypatch.setattr(Sphere, "normal", lambda self, p, prim: (self.center - p) / self.radius)
+    outward = Sphere.kernels.normals
+    inward = lambda s, pool, prim, x, y, z: tuple(-c for c in outward(s, pool, prim, x, y, z))
+    monkeypatch.setattr(Sphere, "kernels", Sphere.kernels._replace(normals=inward))
     assert not compare_images(rendered(yaml_scene, extra=GLASS), good).ok
 
 

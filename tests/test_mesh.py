@@ -6,13 +6,14 @@ import pickle
 import numpy as np
 import pytest
 
-from rtcli.core.vec import normalize
+from rtcli.core.vec import unit3 as normalize
 from rtcli.errors import SceneError
 from rtcli.scenefile.obj import parse_obj, read_obj
+from rtcli.scenefile.objects import shape_from
 from rtcli.scenefile.params import Params
 from rtcli.scenefile.yamlfile import parse
 from rtcli.shapes.mesh import Mesh
-from rtcli.shapes.planar import Triangle
+from rtcli.shapes.triangle import NA, Triangle
 
 DATA = os.path.join(os.path.dirname(__file__), "data")
 MODELS = "/work/shared/models"
@@ -103,13 +104,13 @@ def test_intersect_equals_triangles_one_by_one():
     unique = np.count_nonzero(each == expected[:, None], axis=1) == 1
     np.testing.assert_array_equal(prim[hit & unique], each.argmin(axis=1)[hit & unique])
     assert np.all(prim[~hit] == -1) and 0.05 < hit.mean() < 0.95
-    np.testing.assert_array_equal(mesh.any_hit(o, d, 1e-6, t_max), hit)
+    np.testing.assert_array_equal(mesh.any_hit(o.T, d.T, 1e-6, t_max), hit)          # components (3, n)
 
 
 def test_degenerate_triangles_are_skipped():
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0]], float)
     mesh = Mesh(v, [[0, 1, 3], [0, 1, 2], [1, 1, 2]])          # collinear, good, repeated vertex
-    assert len(mesh.a) == 1
+    assert len(mesh) == 1
     t, prim = mesh.intersect(np.array([[0.2, 0.2, 1]]), np.array([[0, 0, -1.0]]), 0, np.inf)
     assert t[0] == 1 and prim[0] == 0
     with pytest.raises(ValueError, match="zero area"):
@@ -150,11 +151,11 @@ def test_uv_without_vt_is_barycentric_as_triangle():
     v = random_soup(rng, 5)
     mesh = Mesh(v, np.arange(15).reshape(3, 5).T)
     tri = Triangle(v[2], v[7], v[12])
-    p = tri.a + 0.3 * tri.e1 + 0.1 * tri.e2
-    np.testing.assert_allclose(mesh.uv(p[None], np.array([2])), tri.uv(p[None], None), atol=1e-12)
+    p = tri.a + 0.3 * (tri.b - tri.a) + 0.1 * (tri.c - tri.a)
+    np.testing.assert_allclose(mesh.uv(p[None], np.array([2])), tri.uv(p[None], np.array([0])), atol=1e-12)
 
 
-# --- from_params ---
+# --- built from YAML (rtcli.scenefile.objects.shape_from) ---
 def mesh_params(tmp_path, body):
     scene = tmp_path / "scene.yaml"
     scene.write_text(f"mesh: {body}\n")
@@ -162,10 +163,10 @@ def mesh_params(tmp_path, body):
     return Params(tree["mesh"], "mesh")
 
 
-def test_from_params_reads_a_file_relative_to_the_scene(tmp_path):
+def test_yaml_reads_a_file_relative_to_the_scene(tmp_path):
     (tmp_path / "m.obj").write_text(TRIANGLE + "f 1 2 3\n")
-    mesh = Mesh.from_params(mesh_params(tmp_path, "{file: m.obj, smooth: true}"))
-    assert mesh.normal_corners is not None and len(mesh.a) == 1      # smooth: true read
+    mesh = shape_from(mesh_params(tmp_path, "{file: m.obj, smooth: true}"), Mesh)
+    assert mesh.smooth and len(mesh) == 1      # smooth: true read
     np.testing.assert_array_equal(mesh.bounds()[1], [1, 1, 0])
 
 
@@ -174,41 +175,41 @@ def test_from_params_reads_a_file_relative_to_the_scene(tmp_path):
     ("# empty\n", "mesh.file: the mesh has no faces: {tmp}/m.obj"),
     (TRIANGLE + "f 1 1 2\n", "mesh.file: all triangles of the mesh have zero area: {tmp}/m.obj"),
 ])
-def test_from_params_errors_point_at_file(tmp_path, obj, message):
+def test_yaml_errors_point_at_file(tmp_path, obj, message):
     if obj is not None:
         (tmp_path / "m.obj").write_text(obj)
     with pytest.raises(SceneError) as e:
-        Mesh.from_params(mesh_params(tmp_path, "{file: m.obj}"))
+        shape_from(mesh_params(tmp_path, "{file: m.obj}"), Mesh)
     assert str(e.value) == f"{tmp_path}/scene.yaml:1:14: " + message.format(tmp=tmp_path)
 
 
-def test_from_params_folder_and_latin1_comment(tmp_path):
+def test_yaml_folder_and_latin1_comment(tmp_path):
     (tmp_path / "m.obj").write_bytes(b"# caf\xe9\n" + (TRIANGLE + "f 1 2 3\n").encode())
-    assert len(Mesh.from_params(mesh_params(tmp_path, "{file: m.obj}")).a) == 1
+    assert len(shape_from(mesh_params(tmp_path, "{file: m.obj}"), Mesh)) == 1
     (tmp_path / "dir.obj").mkdir()
     with pytest.raises(SceneError, match=r"mesh\.file: cannot read .*dir\.obj: Is a directory"):
-        Mesh.from_params(mesh_params(tmp_path, "{file: dir.obj}"))
+        shape_from(mesh_params(tmp_path, "{file: dir.obj}"), Mesh)
 
 
-def test_from_params_obj_error_names_the_obj_file(tmp_path):
+def test_yaml_obj_error_names_the_obj_file(tmp_path):
     (tmp_path / "m.obj").write_text(TRIANGLE + "f 1 2 7\n")
     with pytest.raises(SceneError, match=r"m\.obj:4:7: vertex index 7 out of range"):
-        Mesh.from_params(mesh_params(tmp_path, "{file: m.obj}"))
+        shape_from(mesh_params(tmp_path, "{file: m.obj}"), Mesh)
 
 
 # --- real models ---
 def test_bunny_loads_and_is_hit_like_brute_force():
     obj = read_obj(os.path.join(MODELS, "stanford-bunny.obj"))
     mesh = pickle.loads(pickle.dumps(Mesh(obj.vertices, obj.faces, smooth=True)))   # picklable for workers
-    assert len(mesh.a) > 69000
+    assert len(mesh) > 69000
     lo, hi = mesh.bounds()
     rng = np.random.default_rng(1)
     target = rng.uniform(lo, hi, (20, 3))
     o = np.broadcast_to((lo + hi) / 2 + [0, 0, 1.0], (20, 3))
     t, prim = mesh.intersect(o, target - o, 1e-9, np.inf)
-    hit_pairs = mesh._pair_test(o, target - o, 1e-9)
+    hit_pairs = mesh.pair_test(o.T, (target - o).T, 1e-9)
     for k in range(20):
-        every = hit_pairs(np.full(len(mesh.a), k), np.arange(len(mesh.a)), np.inf)
+        every = hit_pairs(np.full(len(mesh), k), np.arange(len(mesh)), np.inf)
         assert every.min() == t[k] and (np.isinf(t[k]) or every[prim[k]] == t[k])
     assert np.isfinite(t).sum() >= 5
     n = mesh.normal(o[:1] + t[:1, None] * (target[:1] - o[:1]), prim[:1])
@@ -221,4 +222,4 @@ def test_models_with_vt_and_vn():
     suzanne = read_obj(os.path.join(MODELS, "suzanne.obj"))
     assert len(suzanne.normals) and np.all(suzanne.normal_faces >= 0)
     mesh = Mesh(suzanne.vertices, suzanne.faces, True, normals=suzanne.normals, normal_faces=suzanne.normal_faces)
-    assert mesh.normal_corners.shape == (len(mesh.a), 3, 3)
+    assert mesh.smooth and np.all(np.any(mesh.pool[:, NA:NA + 9] != 0, axis=1))    # every face's corner normals

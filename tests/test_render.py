@@ -101,7 +101,7 @@ def test_samples_2_is_close_different_and_deterministic(reference):
 
 def test_a_pixel_is_the_mean_of_its_samples():
     """With samples n, a pixel's float color is the mean of the n x n rays traced at sample_positions."""
-    from rtcli.render import render_tile
+    from rtcli.render import camera_rays, render_tile
     from rtcli.stats import Stats
     from rtcli.wavefront.trace import trace
     scene2 = scene_from_yaml(SCENE.format(samples=2))
@@ -109,7 +109,7 @@ def test_a_pixel_is_the_mean_of_its_samples():
     colors, _ = render_tile(scene2, Job(W, H), i, j)
     xs, ys = sample_positions(i, j, 2)
     cam = scene2.camera(W, H)
-    traced = [trace(scene2, cam.rays(x, y, W, H), 1, Stats()) for x, y in zip(xs, ys)]
+    traced = [trace(scene2, camera_rays(cam, x, y, W, H), 1, Stats()).T for x, y in zip(xs, ys)]
     np.testing.assert_allclose(colors, np.mean(traced, axis=0), rtol=1e-12, atol=1e-15)
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rtcli.render import camera_rays
 from rtcli.wavefront.intersect import find_first_hit
 from tests.conftest import one_pixel, scene_from_yaml
 
@@ -254,10 +255,10 @@ def floor_beside_ball(x: float) -> np.ndarray:
     target = np.array([x, 0.0, 0.0])
     eye = target + np.array([10.0, 5.0 * x, 0.0])
     scene = scene_from_yaml(CONTACT.format(eye=vec(eye), target=vec(target)))
-    rays = scene.camera(1, 1).rays(np.array([0.5]), np.array([0.5]), 1, 1)
+    rays = camera_rays(scene.camera(1, 1), np.array([0.5]), np.array([0.5]), 1, 1)
     hits = find_first_hit(scene, rays)
     assert hits.obj[0] == 0, "the camera must see the floor, not the ball"
-    np.testing.assert_allclose(rays.at(hits.t)[0], target, atol=1e-12)
+    np.testing.assert_allclose(rays.at(hits.t)[:, 0], target, atol=1e-12)
     return one_pixel(scene)
 
 

@@ -14,8 +14,11 @@ import pytest
 from rtcli.core import transform as tf
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, SceneObject
-from rtcli.shapes.planar import Plane, Polygon, Square, Triangle
+from rtcli.shapes.plane import Plane
+from rtcli.shapes.polygon import Polygon
 from rtcli.shapes.sphere import Sphere
+from rtcli.shapes.square import Square
+from rtcli.shapes.triangle import Triangle
 from rtcli.wavefront.intersect import find_first_hit, surface
 from rtcli.wavefront.rays import Rays
 
@@ -108,12 +111,12 @@ def test_smooth_triangle_interpolates_normals():
     """Shading normal = normalize((1 - a - b) na + a nb + b nc) at barycentrics (a, b) = (0.25, 0.5)."""
     shape = SHAPES["triangle_smooth"]
     s = scene_of(shape)
-    rays = Rays(np.array([[0.5, 1.0, 3.0]]), np.array([[0.0, 0, -1]]))
+    rays = Rays.from_rows(np.array([[0.5, 1.0, 3.0]]), np.array([[0.0, 0, -1]]))
     sf = surface(s, rays, find_first_hit(s, rays))
     na, nb, nc = (np.array(n) / np.linalg.norm(n) for n in SMOOTH_NORMALS)
     n = 0.25 * na + 0.25 * nb + 0.5 * nc
-    np.testing.assert_allclose(sf.n[0], n / np.linalg.norm(n), atol=1e-14)
-    np.testing.assert_allclose(sf.ng[0], [0, 0, 1], atol=1e-15)
+    np.testing.assert_allclose(sf.n.T[0], n / np.linalg.norm(n), atol=1e-14)
+    np.testing.assert_allclose(sf.ng.T[0], [0, 0, 1], atol=1e-15)
 
 
 def test_convex_polygon_in_a_tilted_plane():
@@ -240,18 +243,18 @@ def test_transformed_sphere_normals_are_unit_and_outward(seed, mirror, from_insi
     u = rng.normal(size=(n_rays, 3))
     u /= np.linalg.norm(u, axis=1)[:, None]
     start = b + (0.05 * rng.uniform(-1, 1, (n_rays, 3)) if from_inside else 20 * u)
-    rays = Rays(start, (u if from_inside else target - start))
+    rays = Rays.from_rows(start, (u if from_inside else target - start))
     hits = find_first_hit(s, rays)
     assert np.all(np.isfinite(hits.t))
     sf = surface(s, rays, hits)
-    np.testing.assert_allclose(np.linalg.norm(sf.n, axis=1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(sf.n.T, axis=1), 1.0, atol=1e-12)
     np.testing.assert_array_equal(sf.entering, not from_inside)
-    outward = np.where(sf.entering[:, None], sf.n, -sf.n)
-    assert np.all(np.sum(outward * (sf.p - b), axis=1) > 0)
-    q = (sf.p - b) @ np.linalg.inv(A).T                             # object space
+    outward = np.where(sf.entering[:, None], sf.n.T, -sf.n.T)
+    assert np.all(np.sum(outward * (sf.p.T - b), axis=1) > 0)
+    q = (sf.p.T - b) @ np.linalg.inv(A).T                             # object space
     grad = q @ np.linalg.inv(A)                                     # A^-T q, row by row
     np.testing.assert_allclose(outward, grad / np.linalg.norm(grad, axis=1)[:, None], atol=1e-9)
-    assert np.all(np.sum(sf.n * rays.direction, axis=1) < 0)        # N faces the incoming ray
+    assert np.all(np.sum(sf.n.T * rays.d.T, axis=1) < 0)        # N faces the incoming ray
 
 
 def on_shape(shape, p):
@@ -279,7 +282,7 @@ def aimed_rays(s: Scene, rng, n):
         target = obj.world_from_object.point(target)
     u = rng.normal(size=(n, 3))
     start = target + 15 * u / np.linalg.norm(u, axis=1)[:, None]
-    return Rays(start, target - start)
+    return Rays.from_rows(start, target - start)
 
 
 @pytest.mark.parametrize("name", SHAPES)
@@ -295,15 +298,15 @@ def test_normals_under_random_transforms_are_unit_and_face_the_ray(name):
         hit = np.isfinite(hits.t)
         assert hit.sum() > 20
         sf = surface(s, rays[hit], hits[hit])
-        d = rays.direction[hit]
-        for n in (sf.n, sf.ng):
+        d = rays.d.T[hit]
+        for n in (sf.n.T, sf.ng.T):
             np.testing.assert_allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-12)
             assert np.all(np.sum(n * d, axis=1) < 0)
         if name in PLANAR and name != "triangle_smooth":
             n_obj = shape.normal(np.zeros((1, 3)), np.zeros(1, dtype=np.int64))[0]
             g = np.linalg.inv(t.m[:3, :3]).T @ n_obj
             g /= np.linalg.norm(g)
-            np.testing.assert_allclose(np.abs(sf.ng @ g), 1.0, atol=1e-12)
+            np.testing.assert_allclose(np.abs(sf.ng.T @ g), 1.0, atol=1e-12)
 
 
 def spawn(s: Scene, p, ng, rng):
@@ -312,7 +315,7 @@ def spawn(s: Scene, p, ng, rng):
     w = rng.normal(size=p.shape)
     w /= np.linalg.norm(w, axis=1)[:, None]
     w = np.where((np.sum(w * ng, axis=1) < 0)[:, None], -w, w)
-    return Rays(p + s.offset * ng, w)
+    return Rays.from_rows(p + s.offset * ng, w)
 
 
 @pytest.mark.parametrize("name", SHAPES)
@@ -327,7 +330,7 @@ def test_spawned_rays_do_not_reintersect(name):
         hits = find_first_hit(s, rays)
         hit = np.isfinite(hits.t)
         sf = surface(s, rays[hit], hits[hit])
-        again = find_first_hit(s, spawn(s, sf.p, sf.ng, rng))
+        again = find_first_hit(s, spawn(s, sf.p.T, sf.ng.T, rng))
         assert np.all(np.isinf(again.t)), \
             f"re-hit at t = {again.t[np.isfinite(again.t)][:5]} (offset {s.offset:g})"
 
@@ -339,10 +342,10 @@ def test_rays_leaving_inside_a_sphere_go_across_it(seed, mirror):
     s = scene_of(Sphere(), random_transform(rng, mirror))
     b = s.objects[0].world_from_object.m[:3, 3]
     u = rng.normal(size=(300, 3))
-    rays = Rays(np.broadcast_to(b, (300, 3)).copy(), u)
+    rays = Rays.from_rows(np.broadcast_to(b, (300, 3)).copy(), u)
     hits = find_first_hit(s, rays)
     sf = surface(s, rays, hits)
     assert not sf.entering.any()
-    again = find_first_hit(s, spawn(s, sf.p, sf.ng, rng))
+    again = find_first_hit(s, spawn(s, sf.p.T, sf.ng.T, rng))
     assert np.all(np.isfinite(again.t))
     assert np.all(again.t > 1e-6 * s.size)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtcli.core.vec import refract
+from rtcli.core import vec as vectors
 from rtcli.wavefront.intersect import find_first_hit, surface
 from rtcli.wavefront.rays import Rays
 from tests.conftest import one_pixel, scene_from_yaml
@@ -163,13 +163,13 @@ def test_slab_without_glass_shows_the_straight_on_strip():
 def test_entering_is_decided_by_the_outward_normal():
     """entering = d . outward normal < 0: top face from above yes, bottom face from inside no, from below yes."""
     s = scene((0, 3, 0), (0, 0, 0), slab(), up=(0, 0, -1))
-    rays = Rays(np.array([[0.0, 3, 0], [0.0, -0.5, 0], [0.0, -3, 0]]),
+    rays = Rays.from_rows(np.array([[0.0, 3, 0], [0.0, -0.5, 0], [0.0, -3, 0]]),
                 np.array([[0.3, -1, 0], [0.3, -1, 0], [0.3, 1, 0]]))
     hits = find_first_hit(s, rays)
     np.testing.assert_array_equal(hits.obj, [0, 1, 1])
     sf = surface(s, rays, hits)
     np.testing.assert_array_equal(sf.entering, [True, False, True])
-    np.testing.assert_allclose(sf.n, [[0, 1, 0], [0, 1, 0], [0, -1, 0]], atol=1e-15)
+    np.testing.assert_allclose(sf.n.T, [[0, 1, 0], [0, 1, 0], [0, -1, 0]], atol=1e-15)
 
 
 # --- total internal reflection: the eye inside the glass, looking up at the top face ---
@@ -209,6 +209,12 @@ def test_total_internal_reflection_has_no_refracted_term(theta):
 
 
 # --- rtcli.core.vec.refract directly ---
+def refract(d, n, eta):
+    """The refract kernel on (n, 3) rows: (unit directions (n, 3), tir (n,))."""
+    *t, tir = vectors.refract(*vectors.split(d), *vectors.split(n), eta)
+    return vectors.stack(*t), tir
+
+
 def frames(k: int, seed: int):
     """k random orthonormal pairs (n, tangent)."""
     rng = np.random.default_rng(seed)

@@ -1,31 +1,40 @@
-"""Bounding volume hierarchy over boxes: binned SAH build, traversal by whole arrays of rays.
+"""Bounding volume hierarchy over boxes (notes 000 11.5): binned SAH build, one node layout,
+two ways to walk it.
 
 Why: a mesh of 100k triangles (or a scene of 1k spheres) is too many primitives
-to test every ray against each one. The BVH is generic: it knows only the
-primitives' boxes; the caller supplies the exact (ray, primitive) test.
+to test every ray against each one. The BVH knows only the primitives' boxes; the
+caller supplies the exact (ray, primitive) test.
 
 Build: binned SAH, in bvh_build.py.
 
-Storage (flat arrays, node 0 is the root): lo/hi (3, k) node boxes (per axis), child (k,)
-index of the left child (the right one is child + 1) or -1 for a leaf,
-start/count (k,) a leaf's range in perm, perm (m,) primitive indices.
+Storage, node 0 the root: `nodes` (k, 6) each node's box lo (3) and hi (3); `links`
+(k, 3) each node's first child (the second is child + 1; -1 for a leaf), and a
+leaf's range start, count in `perm`; `perm` (m,) the primitives, leaf by leaf.
 
-Traversal: a frontier of (ray, node) pairs, one tree level per step. All pairs
-are slab-tested at once, with each ray's best t so far as the far limit; leaf
-pairs become (ray, primitive) pairs for the caller's test, which lowers the
-rays' best t so later levels prune; interior pairs expand to both children.
-Rays are processed in chunks to bound memory.
+Two walks of the same tree, through the same slab test (`slab`):
+- `BVH.intersect` / `BVH.any_hit`, numpy: a frontier of (ray, node) pairs, one tree
+  level per step, for whole arrays of rays. Leaf pairs become (ray, primitive)
+  pairs for the caller's test, which lowers the rays' best t so later levels prune.
+- `walk`, per ray (compiled by numba in the compiled engine, and used by the numpy
+  engine for meshes and sets of objects when numba is installed): depth first,
+  nearer child first, with an explicit stack, pruned by the best t so far. It calls
+  LEAF(g, entry, ray, t_min, best, shadow, stack, top) on each leaf entry; `walk` is
+  specialised for triangles or scene objects by binding LEAF (variants.compiled).
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from rtcli.core.bvh_build import build
+from rtcli.variants import INF, kernel, narrow, per_ray
 
-CHUNK = 1 << 13                         # rays traversed together
+CHUNK = 1 << 13                         # rays traversed together by the numpy walk
 PAD = 1e-9                              # boxes grow by PAD x their largest |coordinate|, so rounding in
                                         # the slab test cannot drop a hit lying on a box face
+CHILD, START, COUNT = 0, 1, 2           # columns of links
 
 
 class BVH:
@@ -34,19 +43,24 @@ class BVH:
     def __init__(self, lo: np.ndarray, hi: np.ndarray, leaf_size: int = 4, bins: int = 12):
         lo, hi = (np.asarray(x, dtype=float).reshape(-1, 3) for x in (lo, hi))
         self.m = len(lo)
-        if self.m == 0:
-            self.box, self.depth = (np.full(3, np.inf), np.full(3, -np.inf)), 0
+        if self.m == 0:                 # an empty tree: one leaf holding nothing
+            self.box, self.depth = (np.full(3, np.inf), np.full(3, -np.inf)), 1
+            self.nodes, self.links = np.zeros((1, 6)), np.array([[-1, 0, 0]], dtype=np.int64)
+            self.perm = np.zeros(0, dtype=np.int64)
             return
         self.box = (lo.min(axis=0), hi.max(axis=0))
-        self.lo, self.hi, self.child, self.start, self.count, self.perm, self.depth = build(lo, hi, leaf_size, bins)
-        self.lo, self.hi = (np.ascontiguousarray(x.T) for x in padded(self.lo, self.hi, self.box))
+        n_lo, n_hi, child, start, count, self.perm, self.depth = build(lo, hi, leaf_size, bins)
+        n_lo, n_hi = padded(n_lo, n_hi, self.box)
+        self.nodes = np.ascontiguousarray(np.concatenate([n_lo, n_hi], axis=1))
+        self.links = np.ascontiguousarray(np.stack([child, start, count], axis=1), dtype=np.int64)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """The union of the primitives' boxes (inf, -inf when there are none)."""
         return self.box[0].copy(), self.box[1].copy()
 
+    # --- the numpy walk ---
     def intersect(self, o, d, t_min, t_max, hit_pairs, sub=None):
-        """Nearest primitive along each ray: (t (n,), prim (n,)), inf and -1 for a miss.
+        """Nearest primitive along each ray (o, d (3, n)): (t (n,), prim (n,)), inf and -1 for a miss.
 
         hit_pairs(rays, prims, t_max_pairs) -> t (p,) is the exact test of
         (ray, primitive) pairs: a hit in (t_min, t_max_pairs), else inf. The
@@ -54,7 +68,7 @@ class BVH:
         With `sub` (an (n,) int array), hit_pairs returns (t, sub_pairs) instead,
         and each ray's winning sub_pairs value (say, a face of the primitive) lands in sub.
         """
-        n = len(o)
+        n = o.shape[1]
         best = np.broadcast_to(np.asarray(t_max, dtype=float), (n,)).copy()
         prim = np.full(n, -1, dtype=np.int64)
 
@@ -73,49 +87,53 @@ class BVH:
 
     def any_hit(self, o, d, t_min, t_max, hit_pairs) -> np.ndarray:
         """(n,) bool: some primitive is hit in (t_min, t_max) (shadow feelers); blocked rays stop."""
-        far = np.broadcast_to(np.asarray(t_max, dtype=float), (len(o),)).copy()
+        n = o.shape[1]
+        far = np.broadcast_to(np.asarray(t_max, dtype=float), (n,)).copy()
+        blocked = np.zeros(n, dtype=bool)
 
         def leaves(r, p):
-            t = hit_pairs(r, p, far[r])
-            far[r[np.isfinite(t)]] = np.nan            # NaN fails every later slab test
+            hit = np.isfinite(hit_pairs(r, p, far[r]))
+            blocked[r[hit]] = True
+            far[r[hit]] = -np.inf                      # fails every later slab test
 
         self._traverse(o, d, t_min, far, leaves)
-        return np.isnan(far)
+        return blocked
 
     def _traverse(self, o, d, t_min, far, leaves):
         """Walk the (ray, node) frontier level by level; far (n,) is read live for pruning."""
-        if self.m == 0 or len(o) == 0:
+        if self.m == 0 or o.shape[1] == 0:
             return
-        n, t_min = len(o), np.asarray(t_min, dtype=float)
-        o, inv = columns(o, d)              # per axis, so the slab test runs on 1-D columns
+        n, t_min = o.shape[1], np.asarray(t_min, dtype=float)
+        with np.errstate(divide="ignore"):
+            inv = 1.0 / d
         for s in range(0, n, CHUNK):
             rays = np.arange(s, min(s + CHUNK, n))
-            rays = rays[self._slab(o[:, rays], inv[:, rays], 0, _at(t_min, rays), far[rays])]
+            rays = rays[self._meets(o, inv, rays, np.zeros(len(rays), np.int64), t_min, far)]
             nodes = np.zeros(len(rays), dtype=np.int64)                              # the root
             while len(rays):
-                leaf = self.child[nodes] < 0
+                child = self.links[nodes, CHILD]
+                leaf = child < 0
                 if leaf.any():
                     leaves(*self._leaf_pairs(rays[leaf], nodes[leaf]))
-                rays, nodes = rays[~leaf], self.child[nodes[~leaf]]
-                rays, nodes = self._children(o, inv, t_min, far, rays, nodes)
+                rays, left = rays[~leaf], child[~leaf]
+                hit_l = self._meets(o, inv, rays, left, t_min, far)
+                hit_r = self._meets(o, inv, rays, left + 1, t_min, far)
+                rays, nodes = np.concatenate([rays[hit_l], rays[hit_r]]), np.concatenate([left[hit_l], left[hit_r] + 1])
 
-    def _children(self, o, inv, t_min, far, rays, left):
-        """The (ray, child) pairs whose child box the ray meets, for both children of each pair's node."""
-        o_r, inv_r, near, far_r = o[:, rays], inv[:, rays], _at(t_min, rays), far[rays]
-        hit_l = self._slab(o_r, inv_r, left, near, far_r)
-        hit_r = self._slab(o_r, inv_r, left + 1, near, far_r)
-        return np.concatenate([rays[hit_l], rays[hit_r]]), np.concatenate([left[hit_l], left[hit_r] + 1])
-
-    def _slab(self, o, inv, nodes, t_min, t_max):
-        """Slab test of (ray, node) pairs against [t_min, t_max]; see slab()."""
-        return slab(o, inv, [lo[nodes] for lo in self.lo], [hi[nodes] for hi in self.hi], t_min, t_max)
+    def _meets(self, o, inv, rays, nodes, t_min, far):
+        """Whether each ray meets its node's box within [t_min, far]."""
+        box = self.nodes[nodes]
+        near = t_min if t_min.ndim == 0 else t_min[rays]
+        with np.errstate(invalid="ignore"):
+            t_in, t_out = slab(*box.T, *o[:, rays], *inv[:, rays], near, far[rays])
+        return t_in <= t_out
 
     def _leaf_pairs(self, rays, nodes):
         """(ray, primitive) pairs for every primitive of each (ray, leaf) pair."""
-        count = self.count[nodes]
+        count = self.links[nodes, COUNT]
         r = np.repeat(rays, count)
         offset = np.arange(len(r)) - np.repeat(np.cumsum(count) - count, count)
-        return r, self.perm[np.repeat(self.start[nodes], count) + offset]
+        return r, self.perm[np.repeat(self.links[nodes, START], count) + offset]
 
 
 def padded(lo, hi, scale_box=None):
@@ -125,31 +143,74 @@ def padded(lo, hi, scale_box=None):
     return lo - pad, hi + pad
 
 
-def slab(o, inv, lo, hi, t_min, t_max):
-    """Kay-Kajiya slab test: does each ray meet its box within [t_min, t_max]?
-
-    o and inv (3, n): ray origins and 1 / directions by axis; lo, hi: per axis,
-    arrays (n,) or numbers. A zero direction component gives +-inf, and NaN
-    (0 x inf) when the origin lies on that slab's plane: the ray then runs inside
-    the closed slab, so NaN must not constrain; np.minimum/maximum keep the NaN
-    and np.fmax/fmin then skip it. A NaN t_max (a blocked ray) fails.
-    """
-    t_in, t_out = t_min, np.inf
-    with np.errstate(invalid="ignore"):
-        for k in range(3):
-            t1 = (lo[k] - o[k]) * inv[k]
-            t2 = (hi[k] - o[k]) * inv[k]
-            t_in = np.fmax(t_in, np.minimum(t1, t2))
-            t_out = np.fmin(t_out, np.maximum(t1, t2))
-        return t_in <= np.minimum(t_out, t_max)
+@kernel
+def slab(lox, loy, loz, hix, hiy, hiz, ox, oy, oz, ix, iy, iz, t_near, t_far):
+    """Kay-Kajiya slab test: the part [t_near, t_far] of a ray (origin o, 1 / direction i) inside
+    the box; it meets the box when t_near <= t_far. Per axis the ray is inside the slab between
+    (lo - o) i and (hi - o) i. A zero direction component gives +-inf, and NaN (0 x inf) when the
+    origin lies on that slab's plane: the ray then runs inside the closed slab, so the axis does
+    not constrain (variants.narrow)."""
+    t_near, t_far = narrow(t_near, t_far, (lox - ox) * ix, (hix - ox) * ix)
+    t_near, t_far = narrow(t_near, t_far, (loy - oy) * iy, (hiy - oy) * iy)
+    return narrow(t_near, t_far, (loz - oz) * iz, (hiz - oz) * iz)
 
 
-def columns(o, d):
-    """(o, 1/d) as (3, n) arrays, the layout slab() wants."""
-    with np.errstate(divide="ignore"):
-        return np.ascontiguousarray(np.asarray(o, float).T), 1.0 / np.ascontiguousarray(np.asarray(d, float).T)
+@per_ray(inline=True)
+def reciprocal(d):
+    """1 / d, +-inf for a zero component."""
+    return 1.0 / d if d != 0 else math.copysign(INF, d)
 
 
-def _at(x, rays):
-    """A per-ray array at rays, or the scalar itself."""
-    return x if x.ndim == 0 else x[rays]
+@per_ray(inline=True)
+def entry(nodes, node, ox, oy, oz, ix, iy, iz, t_near, t_far):
+    """Where the ray enters node's box within [t_near, t_far], inf if it does not."""
+    t_in, t_out = slab(nodes[node, 0], nodes[node, 1], nodes[node, 2], nodes[node, 3], nodes[node, 4],
+                       nodes[node, 5], ox, oy, oz, ix, iy, iz, t_near, t_far)
+    return t_in if t_in <= t_out else INF
+
+
+@per_ray
+def walk(g, root, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
+    """(t, entry, prim): the nearest hit in (t_min, t_max) among the leaf entries of the tree
+    at `root` in g.nodes / g.links / g.perm, by LEAF; entry -1 on a miss. With `shadow`, the
+    first hit found will do. stack[bottom:] is scratch (a LEAF may walk a tree of its own above)."""
+    ix, iy, iz = reciprocal(dx), reciprocal(dy), reciprocal(dz)
+    best, won, prim = t_max, -1, 0
+    stack[bottom], top = root, bottom + 1
+    while top > bottom:
+        top -= 1
+        node = stack[top]
+        if entry(g.nodes, node, ox, oy, oz, ix, iy, iz, t_min, best) == INF:    # best may have shrunk
+            continue
+        child = g.links[node, CHILD]
+        if child >= 0:                                  # push the farther child first
+            near = entry(g.nodes, child, ox, oy, oz, ix, iy, iz, t_min, best)
+            far = entry(g.nodes, child + 1, ox, oy, oz, ix, iy, iz, t_min, best)
+            first, second = child, child + 1
+            if far < near:
+                near, far, first, second = far, near, second, first
+            if far < INF:
+                stack[top] = second
+                top += 1
+            if near < INF:
+                stack[top] = first
+                top += 1
+            continue
+        start = g.links[node, START]
+        for j in range(start, start + g.links[node, COUNT]):
+            t, p = LEAF(g, g.perm[j], ox, oy, oz, dx, dy, dz, t_min, best, shadow, stack, top)  # noqa: F821
+            if t < best:
+                best, won, prim = t, g.perm[j], p
+                if shadow:
+                    return best, won, prim
+    return (best if won >= 0 else INF), won, prim
+
+
+@per_ray(entry=True)
+def walk_rays(g, root, o, d, t_min, t_max, shadow, t, hit, prim, stack):
+    """`walk` for each ray of o, d (3, n) with its t_min, t_max (n,): into t, hit (the entry, -1
+    on a miss) and prim (n,)."""
+    for i in range(o.shape[1]):
+        t[i], hit[i], prim[i] = WALK(g, root, o[0, i], o[1, i], o[2, i], d[0, i], d[1, i], d[2, i],  # noqa: F821
+                                     t_min[i], t_max[i], shadow, stack, 0)
+

@@ -2,7 +2,8 @@
 
 All three forms map a sample position (x, y) in pixel units, where pixel (i, j)'s
 centre is (i + 0.5, j + 0.5) and (0, 0) is the top-left corner, to a point p on
-the image plane; the ray is eye + lambda (p - eye).
+the image plane; the ray is eye + lambda (p - eye). A Camera packs that affine map
+as a row of 12 floats (EYE, ORIGIN, RIGHT, DOWN), which `primary_ray` reads.
 """
 
 from __future__ import annotations
@@ -11,8 +12,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.core.vec import cross, normalize
-from rtcli.wavefront.rays import Rays
+from rtcli.core.vec import cross3, unit3
+from rtcli.variants import kernel
+
+EYE, ORIGIN, RIGHT, DOWN = 0, 3, 6, 9     # offsets of the vectors in Camera.row
+
+
+@kernel
+def primary_ray(cam, x, y, nc, nr):
+    """The ray through pixel coordinates (x, y) of an nc x nr image: from the eye to
+    p = origin + (x / nc) right + (y / nr) down. Returns (ox, oy, oz, dx, dy, dz)."""
+    a, b = x / nc, y / nr
+    px = cam[ORIGIN] + a * cam[RIGHT] + b * cam[DOWN]
+    py = cam[ORIGIN + 1] + a * cam[RIGHT + 1] + b * cam[DOWN + 1]
+    pz = cam[ORIGIN + 2] + a * cam[RIGHT + 2] + b * cam[DOWN + 2]
+    return cam[EYE], cam[EYE + 1], cam[EYE + 2], px - cam[EYE], py - cam[EYE + 1], pz - cam[EYE + 2]
 
 
 def eye_basis(eye, look_at, up) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -20,12 +34,12 @@ def eye_basis(eye, look_at, up) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     w = np.asarray(look_at, float) - np.asarray(eye, float)
     if np.linalg.norm(w) == 0:
         raise ValueError("look_at must differ from eye")
-    w = normalize(w)
-    side = cross(w, np.asarray(up, float))
+    w = unit3(w)
+    side = cross3(w, np.asarray(up, float))
     if np.linalg.norm(side) <= 1e-9 * np.linalg.norm(up):
         raise ValueError("up must not be parallel to the view direction")
-    u = normalize(side)
-    return u, cross(u, w), w
+    u = unit3(side)
+    return u, cross3(u, w), w
 
 
 @dataclass(frozen=True)
@@ -37,9 +51,9 @@ class Camera:
     right: np.ndarray       # change of p over the whole image width (x: 0 -> nc)
     down: np.ndarray        # change of p over the whole image height (y: 0 -> nr)
 
-    def rays(self, x: np.ndarray, y: np.ndarray, nc: int, nr: int) -> Rays:
-        p = (self.origin + (x / nc)[:, None] * self.right + (y / nr)[:, None] * self.down)
-        return Rays(np.broadcast_to(self.eye, p.shape).copy(), p - self.eye)
+    @property
+    def row(self) -> np.ndarray:
+        return np.concatenate([self.eye, self.origin, self.right, self.down]).astype(float)
 
 
 def from_fov(eye, look_at, up, fov: float, nc: int, nr: int) -> Camera:

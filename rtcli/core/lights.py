@@ -1,7 +1,8 @@
 """Point lights with quadratic attenuation (notes 004), and optional spot and area lights.
 
 A light is a list of sample points with intensities: a point light has one, an
-area light n x n jittered points on its parallelogram, each with I / n^2.
+area light n x n jittered points on its parallelogram, each with I / n^2. For the
+kernels a light is a row of floats (`PointLight.row`), read by the names below.
 """
 
 from __future__ import annotations
@@ -10,8 +11,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.core.jitter import uniform
+from rtcli.core.jitter import hash_point
 from rtcli.core.vec import dot
+from rtcli.variants import kernel, maximum, select, sqrt
+
+# The light row: position l, color I, attenuation [c0, c1, c2], spot? (1 or 0), the spot's unit
+# axis, cos of its half angle and falloff exponent, area samples n (0: a point), edges u and v.
+POSITION, COLOR, ATTENUATION, IS_SPOT, SPOT_AXIS, SPOT_COS, SPOT_FALLOFF, AREA_N, AREA_U, AREA_V = (
+    0, 3, 6, 9, 10, 13, 14, 15, 16, 19)
+LIGHT_WIDTH = 22
 
 
 @dataclass(frozen=True)
@@ -26,28 +34,51 @@ class PointLight:
     area_v: np.ndarray | None = None
     area_samples: int = 1                # n: n x n points
 
-    def attenuate(self, r: np.ndarray) -> np.ndarray:
-        """att(r) = 1 / (c0 + c1 r + c2 r^2)."""
-        c0, c1, c2 = self.attenuation
-        return 1.0 / (c0 + c1 * r + c2 * r * r)
+    @property
+    def samples(self) -> int:
+        """How many points stand for the light: 1, or n x n for an area light."""
+        return 1 if self.area_u is None else self.area_samples ** 2
 
-    def spot_factor(self, L: np.ndarray) -> np.ndarray:
-        """1 outside of spot lights; for a spot, (cos angle)^falloff inside the cone, 0 outside."""
-        if self.spot_direction is None:
-            return np.ones(len(L))
-        cos = -dot(L, self.spot_direction)
-        return np.where(cos >= self.spot_cos, np.maximum(cos, 0) ** self.spot_falloff, 0.0)
+    @property
+    def row(self) -> np.ndarray:
+        spot, area = self.spot_direction is not None, self.area_u is not None
+        zero = np.zeros(3)
+        return np.array([*self.position, *self.color, *self.attenuation, float(spot),
+                         *(self.spot_direction if spot else zero), self.spot_cos, self.spot_falloff,
+                         self.area_samples if area else 0, *(self.area_u if area else zero),
+                         *(self.area_v if area else zero)], dtype=float)
 
-    def sample_points(self, p: np.ndarray) -> list[np.ndarray]:
-        """Positions to shade hit points p against: the light itself, or for an area
-        light n x n points jittered within their cells (jitter hashed from p)."""
-        if self.area_u is None:
-            return [np.broadcast_to(self.position, p.shape)]
-        k, points = self.area_samples, []
-        for cell in range(k * k):
-            a, b = divmod(cell, k)
-            ju = uniform(p[:, 0], p[:, 1], p[:, 2], cell, 0)[:, None]
-            jv = uniform(p[:, 0], p[:, 1], p[:, 2], cell, 1)[:, None]
-            points.append(self.position + ((a + ju) / k - 0.5) * self.area_u
-                          + ((b + jv) / k - 0.5) * self.area_v)
-        return points
+
+@kernel
+def sample_point(light, cell, px, py, pz):
+    """Sample `cell` of the light, as seen from the hit point p: the light's position, or for an
+    area light the point jittered within cell (a, b) of its n x n grid (jitter hashed from p)."""
+    n = light[AREA_N]
+    if n == 0:
+        return light[POSITION], light[POSITION + 1], light[POSITION + 2]
+    fu = (cell // n + hash_point(px, py, pz, cell, 0)) / n - 0.5
+    fv = (cell % n + hash_point(px, py, pz, cell, 1)) / n - 0.5
+    return (light[POSITION] + fu * light[AREA_U] + fv * light[AREA_V],
+            light[POSITION + 1] + fu * light[AREA_U + 1] + fv * light[AREA_V + 1],
+            light[POSITION + 2] + fu * light[AREA_U + 2] + fv * light[AREA_V + 2])
+
+
+@kernel
+def toward(qx, qy, qz, px, py, pz):
+    """(L, r): the unit vector from p to the light point q, and the distance r."""
+    lx, ly, lz = qx - px, qy - py, qz - pz
+    r = sqrt(lx * lx + ly * ly + lz * lz)
+    return lx / r, ly / r, lz / r, r
+
+
+@kernel
+def weight(light, r, Lx, Ly, Lz, samples):
+    """The share of I reaching the point: att(r) = 1 / (c0 + c1 r + c2 r^2) (notes 004), times
+    the spot factor (cos of the angle to the axis)^falloff inside the cone and 0 outside, over
+    the number of the light's sample points."""
+    att = 1.0 / (light[ATTENUATION] + light[ATTENUATION + 1] * r + light[ATTENUATION + 2] * r * r)
+    if light[IS_SPOT] == 0:
+        return att * 1.0 / samples
+    cos = -dot(Lx, Ly, Lz, light[SPOT_AXIS], light[SPOT_AXIS + 1], light[SPOT_AXIS + 2])
+    spot = select(cos >= light[SPOT_COS], maximum(cos, 0.0) ** light[SPOT_FALLOFF], 0.0)
+    return att * spot / samples

@@ -1,7 +1,8 @@
 """Materials: the coefficients of the shading equation, and a table of them by index.
 
 `MaterialTable` gathers every material's coefficients into arrays, so shading all
-hits is one vectorized expression indexed by each hit's material.
+hits is one vectorized expression indexed by each hit's material (and the compiled
+engine reads the same arrays, one hit at a time).
 """
 
 from __future__ import annotations
@@ -9,6 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from rtcli.core.textures import ImageTexture, texture_row
 
 
 def _rgb(x) -> np.ndarray:
@@ -30,19 +33,31 @@ class Material:
 
 
 class MaterialTable:
-    """Per-coefficient arrays, row k = material k."""
+    """Per-coefficient arrays, row k = material k; textures as rows over one texel array."""
 
     def __init__(self, materials: list[Material]):
         self.materials = list(materials)
         stack = lambda name: np.array([getattr(m, name) for m in materials], dtype=float)
         self.ka, self.kd, self.ks = stack("ambient"), stack("diffuse"), stack("specular")
-        self.n, self.emission = stack("shininess"), stack("emission")
+        self.shininess, self.emission = stack("shininess"), stack("emission")
         self.kr, self.kt, self.ior = stack("reflection"), stack("transmission"), stack("ior")
         self.shadow = np.array([m.shadow for m in materials], dtype=bool)
         self.shiny = self.ks.max(axis=1) > 0            # which materials need the specular term,
         self.mirror = self.kr.max(axis=1) > 0           # a mirror ray,
         self.clear = self.kt.max(axis=1) > 0            # a refracted ray
         self.textured = [k for k, m in enumerate(materials) if m.texture is not None]
+        self.texture, self.texels = _texture_rows(materials)
 
     def __len__(self) -> int:
         return len(self.materials)
+
+
+def _texture_rows(materials) -> tuple[np.ndarray, np.ndarray]:
+    """(M, 12) texture rows and the (N, 3) texels of all image textures, one after another."""
+    rows, texels, first = [], [np.zeros((0, 3))], 0
+    for m in materials:
+        rows.append(texture_row(m.texture, first))
+        if isinstance(m.texture, ImageTexture):
+            texels.append(m.texture.texels.reshape(-1, 3))
+            first += len(texels[-1])
+    return np.array(rows).reshape(-1, 12), np.ascontiguousarray(np.concatenate(texels), dtype=float)

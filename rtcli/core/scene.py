@@ -1,4 +1,4 @@
-"""The scene model: plain data built by build.py, read by the core. Picklable."""
+"""The scene model: plain data built by rtcli/scenefile/, read by both engines. Picklable."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 
 from rtcli.core.bvh import padded
 from rtcli.core.materials import MaterialTable
-from rtcli.core.transform import Transform, outer_bounds, ray_into
+from rtcli.core.transform import Transform, outer_bounds
 
 
 @dataclass
@@ -21,9 +21,10 @@ class SceneObject:
     world_from_object: Transform | None = None     # None: object space is world space
     kind: str = ""                   # the YAML shape name, for legends
 
-    def to_object(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The ray in object space (notes 000 11.3.4)."""
-        return ray_into(self.world_from_object, o, d)
+    @functools.cached_property
+    def transform(self) -> np.ndarray | None:
+        """The packed transform the kernels read (rtcli.core.transform), None without one."""
+        return None if self.world_from_object is None else self.world_from_object.packed
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray] | None:
         """World-space box, or None when unbounded."""
@@ -50,7 +51,7 @@ class Scene:
     ambient: np.ndarray = field(default_factory=lambda: np.full(3, 0.1))      # Ia
     settings: Settings = field(default_factory=Settings)
     eye: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    accel: object = None             # rtcli.wavefront.accel.Accelerator, built by prepare()
+    accel: object = None             # the numpy engine's rtcli.wavefront.accel.Accelerator, when built
 
     @functools.cached_property
     def boxes(self) -> list:
@@ -69,3 +70,8 @@ class Scene:
     def offset(self) -> float:
         """World-space distance a spawned ray starts off its surface."""
         return self.settings.epsilon * self.size
+
+    @functools.cached_property
+    def light_rows(self) -> np.ndarray:
+        """(L, 22) the lights as the kernels read them (rtcli.core.lights)."""
+        return np.array([light.row for light in self.lights]).reshape(-1, 22)

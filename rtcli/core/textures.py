@@ -1,10 +1,22 @@
-"""Textures: a color T that modulates ambient and diffuse (notes 000 11.7.2)."""
+"""Textures: a color T that modulates ambient and diffuse (notes 000 11.7.2).
+
+For the kernels a material's texture is a row of floats (`texture_row`): its kind,
+then a checker's 1/size and two colors, or an image's place in a texel array
+(first texel, width, height) and whether it repeats. Texels are one (N, 3) array
+of floats, an image's rows one after another from its top row.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+
+from rtcli.variants import floor, kernel, maximum, minimum, select, to_int
+
+NONE, CHECKER, IMAGE = 0, 1, 2                        # texture kinds
+KIND, INV_SIZE, COLOR1, COLOR2, FIRST, WIDTH, HEIGHT, REPEAT = 0, 1, 2, 5, 8, 9, 10, 11
+TEXTURE_WIDTH = 12
 
 
 @dataclass(frozen=True)
@@ -19,10 +31,6 @@ class Checker:
     color2: np.ndarray
     size: float = 1.0
 
-    def color(self, p_object: np.ndarray, uv: np.ndarray) -> np.ndarray:
-        cells = np.floor(p_object * (1 / self.size) + 1e-6).sum(axis=1)      # an integer, as a float
-        return np.where((np.fmod(cells, 2) == 0)[:, None], self.color1, self.color2)
-
 
 @dataclass(frozen=True)
 class ImageTexture:
@@ -36,19 +44,68 @@ class ImageTexture:
     texels: np.ndarray      # (h, w, 3) float, row 0 at the top
     repeat: bool = True
 
-    def color(self, p_object: np.ndarray, uv: np.ndarray) -> np.ndarray:
-        h, w, _ = self.texels.shape
-        u, v = uv[:, 0], uv[:, 1]
-        if self.repeat:
-            u, v = u - np.floor(u), v - np.floor(v)
-        x = np.clip(u, 0, 1) * w - 0.5                 # continuous texel coordinates
-        y = (1 - np.clip(v, 0, 1)) * h - 0.5
-        x0, y0 = np.floor(x), np.floor(y)
-        fx, fy = (x - x0)[:, None], (y - y0)[:, None]
-        wrap = (lambda k, n: k % n) if self.repeat else (lambda k, n: np.clip(k, 0, n - 1))
-        xa, xb = wrap(x0.astype(np.int64), w), wrap(x0.astype(np.int64) + 1, w)
-        ya, yb = wrap(y0.astype(np.int64), h), wrap(y0.astype(np.int64) + 1, h)
-        t = self.texels
-        top = t[ya, xa] * (1 - fx) + t[ya, xb] * fx
-        bottom = t[yb, xa] * (1 - fx) + t[yb, xb] * fx
-        return top * (1 - fy) + bottom * fy
+
+def texture_row(texture, first: int = 0) -> np.ndarray:
+    """The kernels' row for a texture (None: no texture); an image's texels start at `first`."""
+    row = np.zeros(TEXTURE_WIDTH)
+    if isinstance(texture, Checker):
+        row[[KIND, INV_SIZE]] = CHECKER, 1 / texture.size
+        row[COLOR1:COLOR1 + 3], row[COLOR2:COLOR2 + 3] = texture.color1, texture.color2
+    elif isinstance(texture, ImageTexture):
+        h, w, _ = texture.texels.shape
+        row[[KIND, FIRST, WIDTH, HEIGHT, REPEAT]] = IMAGE, first, w, h, float(texture.repeat)
+    return row
+
+
+@kernel
+def checker(tex, x, y, z):
+    """The checker's color at the object-space point (x, y, z)."""
+    s = tex[INV_SIZE]
+    cells = floor(x * s + 1e-6) + floor(y * s + 1e-6) + floor(z * s + 1e-6)    # an integer, as a float
+    even = cells % 2.0 == 0
+    return (select(even, tex[COLOR1], tex[COLOR2]), select(even, tex[COLOR1 + 1], tex[COLOR2 + 1]),
+            select(even, tex[COLOR1 + 2], tex[COLOR2 + 2]))
+
+
+@kernel
+def wrap(k, n, repeat):
+    """A texel index: modulo n when the picture tiles, else clamped to 0 .. n - 1."""
+    if repeat:
+        return k % n
+    return minimum(maximum(k, 0), n - 1)
+
+
+@kernel
+def bilinear(texels, top, bottom, xa, xb, fx, fy, channel):
+    """One channel between four texels: columns xa, xb of the rows starting at `top`, `bottom`."""
+    upper = texels[top + xa, channel] * (1 - fx) + texels[top + xb, channel] * fx
+    lower = texels[bottom + xa, channel] * (1 - fx) + texels[bottom + xb, channel] * fx
+    return upper * (1 - fy) + lower * fy
+
+
+@kernel
+def image(tex, texels, u, v):
+    """The picture's color at (u, v), bilinear between texel centres."""
+    first, w, h, repeat = to_int(tex[FIRST]), to_int(tex[WIDTH]), to_int(tex[HEIGHT]), tex[REPEAT] != 0
+    if repeat:
+        u, v = u - floor(u), v - floor(v)
+    x = minimum(maximum(u, 0.0), 1.0) * w - 0.5          # continuous texel coordinates
+    y = (1 - minimum(maximum(v, 0.0), 1.0)) * h - 0.5
+    x0, y0 = floor(x), floor(y)
+    fx, fy = x - x0, y - y0
+    xa, xb = wrap(to_int(x0), w, repeat), wrap(to_int(x0) + 1, w, repeat)
+    top, bottom = first + wrap(to_int(y0), h, repeat) * w, first + wrap(to_int(y0) + 1, h, repeat) * w
+    return (bilinear(texels, top, bottom, xa, xb, fx, fy, 0), bilinear(texels, top, bottom, xa, xb, fx, fy, 1),
+            bilinear(texels, top, bottom, xa, xb, fx, fy, 2))
+
+
+@kernel
+def texture_color(tex, texels, x, y, z, u, v):
+    """T at a hit: 1 without a texture, the checker's color at the object-space point (x, y, z),
+    or the picture's at the shape's (u, v)."""
+    kind = tex[KIND]
+    if kind == CHECKER:
+        return checker(tex, x, y, z)
+    if kind == IMAGE:
+        return image(tex, texels, u, v)
+    return 1.0, 1.0, 1.0

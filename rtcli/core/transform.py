@@ -1,8 +1,11 @@
-"""Affine transforms on arrays of points, vectors and normals (notes 000, 11.3.4 and 11.6.1).
+"""Affine transforms of points, vectors and normals (notes 000, 11.3.4 and 11.6.1).
 
-A Transform keeps its 4x4 matrix `m` and the inverse `m_inv`. Normals go through
-the inverse transpose A^-T. Products are written out per component (not BLAS) so
-a row's result never depends on how many rows share the batch.
+A Transform keeps its 4x4 matrix `m` (world_from_object) and the inverse `m_inv`.
+For the kernels it is packed as three 3x4 matrices in a row of 36 floats
+(`Transform.packed`): world_from_object (WORLD), object_from_world (OBJECT), and the
+inverse transpose A^-T that takes object-space normals to world space (NORMAL, its
+4th column 0). Products are written out per component, so a row's result never
+depends on how many rows share the batch.
 """
 
 from __future__ import annotations
@@ -11,10 +14,40 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rtcli.core.vec import split, stack
+from rtcli.variants import kernel
 
-def _apply(a: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Rows of x (n, 3) times the 3x3 matrix a: a @ x_k for each k."""
-    return x[:, 0:1] * a[:, 0] + x[:, 1:2] * a[:, 1] + x[:, 2:3] * a[:, 2]
+WORLD, OBJECT, NORMAL, PACKED = 0, 12, 24, 36        # offsets of the 3x4 matrices in Transform.packed
+
+
+@kernel
+def linear(m, at, x, y, z):
+    """The 3x3 part of the 3x4 matrix m[at:at + 12] (row by row) times the vector (x, y, z)."""
+    return (x * m[at] + y * m[at + 1] + z * m[at + 2],
+            x * m[at + 4] + y * m[at + 5] + z * m[at + 6],
+            x * m[at + 8] + y * m[at + 9] + z * m[at + 10])
+
+
+@kernel
+def affine(m, at, x, y, z):
+    """The 3x4 matrix m[at:at + 12] times the point (x, y, z, 1)."""
+    rx, ry, rz = linear(m, at, x, y, z)
+    return rx + m[at + 3], ry + m[at + 7], rz + m[at + 11]
+
+
+@kernel
+def ray_to_object(m, at, ox, oy, oz, dx, dy, dz):
+    """The ray o + t d taken into object space by the packed transform at m[at:] (notes 000
+    11.3.4): the inverse transform of its start and direction; t keeps its meaning."""
+    qx, qy, qz = affine(m, at + OBJECT, ox, oy, oz)
+    ex, ey, ez = linear(m, at + OBJECT, dx, dy, dz)
+    return qx, qy, qz, ex, ey, ez
+
+
+@kernel
+def normal_to_world(m, at, nx, ny, nz):
+    """A^-T n: an object-space normal in world space (notes 000 11.6.1); not unit."""
+    return linear(m, at + NORMAL, nx, ny, nz)
 
 
 @dataclass(frozen=True)
@@ -44,15 +77,22 @@ class Transform:
     def inverse(self) -> "Transform":
         return Transform(self.m_inv, self.m)
 
+    @property
+    def packed(self) -> np.ndarray:
+        """(36,) world_from_object, object_from_world and A^-T, each 3x4 row by row."""
+        normal = np.zeros((3, 4))
+        normal[:, :3] = self.m_inv[:3, :3].T
+        return np.concatenate([self.m[:3].ravel(), self.m_inv[:3].ravel(), normal.ravel()])
+
     def point(self, p: np.ndarray) -> np.ndarray:
-        return _apply(self.m[:3, :3], p) + self.m[:3, 3]
+        return stack(*affine(self.packed, WORLD, *split(p)))
 
     def vector(self, v: np.ndarray) -> np.ndarray:
-        return _apply(self.m[:3, :3], v)
+        return stack(*linear(self.packed, WORLD, *split(v)))
 
     def normal(self, n: np.ndarray) -> np.ndarray:
         """A^-T n (not normalized)."""
-        return _apply(self.m_inv[:3, :3].T, n)
+        return stack(*normal_to_world(self.packed, 0, *split(n)))
 
 
 def translate(t) -> Transform:
@@ -86,17 +126,6 @@ def bounds_of_box(t: Transform, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndar
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     p = t.point(corners)
     return p.min(axis=0), p.max(axis=0)
-
-
-def ray_into(world_from_object: Transform | None, o: np.ndarray, d: np.ndarray):
-    """The ray o + t d in object space: inverse-transformed start and direction (notes 000 11.3.4).
-
-    t keeps its meaning. None means the object space is the world space.
-    """
-    if world_from_object is None:
-        return o, d
-    inv = world_from_object.inverse
-    return inv.point(o), inv.vector(d)
 
 
 def outer_bounds(world_from_object: Transform | None, box):

@@ -1,7 +1,7 @@
-"""Scene file -> Scene: the top level, the camera, lights and settings (SCENE_FORMAT.md).
+"""Scene file -> Scene: the top level, the camera, lights and settings (docs/scene-format.md).
 
-Only this module, build_objects.py, params.py and yamlfile.py know YAML keys.
-Every key is read through Params, so unknown keys are reported with file:line:col.
+Only the modules of rtcli/scenefile/ know YAML keys. Every key is read through
+Params, so unknown keys are reported with file:line:col.
 """
 
 from __future__ import annotations
@@ -17,20 +17,13 @@ from rtcli.core.scene import Scene, Settings
 from rtcli.scenefile import yamlfile
 from rtcli.scenefile.objects import ObjectBuilder, material_from
 from rtcli.scenefile.params import Params, as_params
-from rtcli.wavefront.accel import Accelerator
 
 MAX_SIZE = 32768
 
 
-def load_scene(path: str, bvh: bool = True) -> Scene:
-    """Read, check and build the scene at `path` (with its includes).
-
-    With `bvh` (the default) a scene of many bounded objects gets a BVH over them.
-    """
-    scene = scene_from_docs(yamlfile.load(path))
-    if bvh and Accelerator.wanted(scene):
-        scene.accel = Accelerator(scene)
-    return scene
+def load_scene(path: str) -> Scene:
+    """Read, check and build the scene at `path` (with its includes)."""
+    return scene_from_docs(yamlfile.load(path))
 
 
 def scene_from_docs(docs: list) -> Scene:
@@ -40,7 +33,7 @@ def scene_from_docs(docs: list) -> Scene:
     for p in params:
         if p.has("version") and p.raw("version") != 1:
             raise p.error("version", f"unsupported version {p.raw('version')!r} (this is version 1)")
-        p.read.update(("version", "include"))
+        p.known("version", "include")
     named, table = {}, [Material()]
     for p in params:
         for name, mp in _materials(p):
@@ -59,33 +52,27 @@ def scene_from_docs(docs: list) -> Scene:
 
 
 def _materials(p: Params):
-    if not p.has("materials"):
-        p.read.add("materials")
+    m = p.optional("materials")
+    if m is None:
         return []
-    m = p.sub("materials")
-    out = [(name, m.sub(name)) for name in m.node]
-    m.read.update(m.node)
-    return out
+    m.known(*m.node)
+    return [(name, m.sub(name)) for name in m.node]
 
 
 def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
     settings = Settings()
-    if p.has("image"):
-        img = p.sub("image")
+    img = p.optional("image")
+    if img is not None:
         settings.width = img.integer("width", 640, 1, MAX_SIZE)
         settings.height = img.integer("height", 480, 1, MAX_SIZE)
         img.check_unused()
-    else:
-        p.read.add("image")
-    if p.has("render"):
-        r = p.sub("render")
+    r = p.optional("render")
+    if r is not None:
         settings.max_depth = r.integer("max_depth", 5, 1, 64)
         settings.specular = r.choice("specular", ("phong", "blinn"), "phong")
         settings.samples = r.integer("samples", 1, 1, 16)
         settings.epsilon = r.number("epsilon", 1e-6, positive=True)
         r.check_unused()
-    else:
-        p.read.add("render")
     camera, eye = camera_from(p.sub("camera"))
     return Scene(camera=camera, objects=builder.objects, materials=MaterialTable(table),
                  lights=lights, background=p.color("background", (0.0, 0.0, 0.0)),
@@ -132,8 +119,8 @@ def light_from(p: Params) -> PointLight:
     if np.any(att < 0) or not np.any(att):
         raise p.error("attenuation", "c0, c1, c2 must be >= 0 and not all 0")
     extra = {}
-    if p.has("spot"):
-        s = p.sub("spot")
+    s = p.optional("spot")
+    if s is not None:
         direction = s.vector("direction")
         if not np.any(direction):
             raise s.error("direction", "must not be the zero vector")
@@ -144,14 +131,10 @@ def light_from(p: Params) -> PointLight:
                      spot_cos=float(np.cos(np.radians(angle))),
                      spot_falloff=s.number("falloff", 0.0, non_negative=True))
         s.check_unused()
-    else:
-        p.read.add("spot")
-    if p.has("area"):
-        a = p.sub("area")
+    a = p.optional("area")
+    if a is not None:
         extra.update(area_u=a.vector("u"), area_v=a.vector("v"), area_samples=a.integer("samples", 3, 1, 16))
         a.check_unused()
-    else:
-        p.read.add("area")
     p.check_unused()
     return PointLight(position, color, att, **extra)
 

@@ -1,4 +1,4 @@
-"""Wavefront OBJ reader: the triangle data a `mesh:` object needs (SCENE_FORMAT, Objects).
+"""Wavefront OBJ reader: the triangle data a `mesh:` object needs (docs/scene-format.md, Objects).
 
 Read statements: `v x y z [w]` (w and trailing vertex colors ignored), `vt u [v [w]]`
 (v defaults to 0), `vn x y z`, and `f` with corners `v`, `v/vt`, `v//vn` or `v/vt/vn`.

@@ -2,7 +2,8 @@
 
 Object ids are 1, 2, 3 ... in file order, depth first through groups; a csg or a
 mesh is one object. Groups are flattened: each child gets the group's transform
-after its own, and the group's material when it names none.
+after its own, and the group's material when it names none. A shape is built from
+the keys its class lists in `params` (rtcli/shapes/base.py), read here.
 """
 
 from __future__ import annotations
@@ -17,9 +18,13 @@ from rtcli.core.materials import Material
 from rtcli.core.scene import SceneObject
 from rtcli.core.textures import Checker, ImageTexture
 from rtcli.errors import SceneError
+from rtcli.scenefile import params as required
+from rtcli.scenefile.obj import read_obj
 from rtcli.scenefile.params import Params, as_params, describe
 from rtcli.scenefile.presets import PRESETS
 from rtcli.shapes import SHAPES
+from rtcli.shapes.base import REQUIRED, ParamError
+from rtcli.shapes.csg import CSG, OPS, Child
 
 OBJECT_KINDS = tuple(SHAPES) + ("csg", "group")
 
@@ -35,8 +40,9 @@ def material_from(p: Params) -> Material:
         pre = PRESETS[name]
         base = dict(ambient=pre.ambient, diffuse=pre.diffuse, specular=pre.specular, shininess=pre.shininess)
     else:
-        p.read.add("preset")
+        p.known("preset")
     diffuse = p.coefficient("diffuse", base.get("diffuse", 0.8))
+    texture = p.optional("texture")
     m = Material(
         ambient=p.coefficient("ambient", base.get("ambient", diffuse)),
         diffuse=diffuse,
@@ -47,15 +53,10 @@ def material_from(p: Params) -> Material:
         transmission=p.coefficient("transmission", 0.0),
         ior=p.number("ior", 1.0, positive=True),
         shadow=p.boolean("shadow", True),
-        texture=texture_from(p.sub("texture", None)) if p.has("texture") else _unread(p, "texture"),
+        texture=None if texture is None else texture_from(texture),
     )
     p.check_unused()
     return m
-
-
-def _unread(p: Params, key: str):
-    p.read.add(key)
-    return None
 
 
 def texture_from(p: Params):
@@ -90,7 +91,7 @@ def load_texels(p: Params, key: str) -> np.ndarray:
 def material_ref(p: Params, key: str, named: dict, table: list, default: int) -> int:
     """The material row for `material:`: a name from `materials` or an inline mapping."""
     if not p.has(key):
-        p.read.add(key)
+        p.known(key)
         return default
     value = p.raw(key)
     if isinstance(value, str):
@@ -105,7 +106,7 @@ def material_ref(p: Params, key: str, named: dict, table: list, default: int) ->
 def transform_from(p: Params) -> tf.Transform | None:
     """The `transform:` list, composed in the order written (first listed applies first)."""
     if not p.has("transform"):
-        p.read.add("transform")
+        p.known("transform")
         return None
     total = tf.Transform.identity()
     for item, where, path in p.items("transform"):
@@ -150,6 +151,61 @@ def _matrix(p: Params) -> np.ndarray:
     return m
 
 
+# --- shapes ---
+def shape_from(p: Params, cls):
+    """A shape of class `cls` from its mapping: each of cls.params read and checked, then the
+    shape made from the values; its own consistency errors are located at the key they blame."""
+    values, files = {}, {}
+    for param in cls.params:
+        default = required.REQUIRED if param.default is REQUIRED else param.default
+        if param.kind == "obj":
+            files[param.key] = os.path.normpath(os.path.join(p.folder, p.string(param.key)))
+            values[param.key] = _read_mesh_file(p, param.key, files[param.key])
+        elif param.kind == "number":
+            values[param.key] = p.number(param.key, default, positive=param.positive,
+                                         non_negative=param.non_negative)
+        elif param.kind == "vector":
+            values[param.key] = p.vector(param.key, default)
+        elif param.kind == "vectors":
+            values[param.key] = p.vectors(param.key, param.min_count, param.count, default)
+        elif param.kind == "boolean":
+            values[param.key] = p.boolean(param.key, default)
+        else:
+            raise TypeError(f"unknown parameter kind {param.kind!r}")
+    try:
+        return cls.from_values(**values)
+    except ParamError as e:
+        key = next((k for k in e.keys if p.has(k)), e.keys[-1])
+        raise p.error(key, f"{e}: {files[key]}" if key in files else str(e)) from None
+
+
+def _read_mesh_file(p: Params, key: str, path: str):
+    try:
+        return read_obj(path)
+    except FileNotFoundError:
+        raise p.error(key, f"file not found: {path}") from None
+    except OSError as e:
+        raise p.error(key, f"cannot read {path}: {e.strerror}") from None
+
+
+def csg_from(p: Params, builder: "ObjectBuilder", material: int) -> CSG:
+    ops = [k for k in OPS if p.has(k)]
+    if len(ops) != 1:
+        raise p.error(None, "a csg needs exactly one of: union, intersection, difference")
+    items = p.items(ops[0])
+    if len(items) < 2:
+        raise p.error(ops[0], f"needs at least 2 objects, got {len(items)}")
+    children = []
+    for item, where, path in items:
+        cp = as_params(item, where, path, "an object (a mapping with a shape key)")
+        shape, t, mat = builder.child(cp, material)
+        if not shape.solid:
+            raise cp.error(None, "a csg child must be a solid: sphere, plane, box, "
+                           "cylinder, cone (capped), torus or csg")
+        children.append(Child(shape, t, mat))
+    return CSG(ops[0], children)
+
+
 # --- objects ---
 class ObjectBuilder:
     """Builds SceneObjects from `objects:` lists, numbering them 1, 2, 3 ..."""
@@ -180,11 +236,7 @@ class ObjectBuilder:
 
     def shape(self, p: Params, kind: str, material: int):
         sp = self._shape_params(p, kind)
-        if kind == "csg":
-            from rtcli.shapes.csg import csg_from
-            shape = csg_from(sp, self, material)
-        else:
-            shape = SHAPES[kind].from_params(sp)
+        shape = csg_from(sp, self, material) if kind == "csg" else shape_from(sp, SHAPES[kind])
         sp.check_unused()
         return shape
 
@@ -207,7 +259,7 @@ class ObjectBuilder:
             raise SceneError(p.node.key_where[kinds[1]], p.key_path(kinds[1]),
                              f"an object has one shape, but '{kinds[0]}' is already given")
         if not kinds:
-            p.read.update(("name", "material", "transform") + OBJECT_KINDS)
+            p.known("name", "material", "transform", *OBJECT_KINDS)
             p.check_unused()
             raise p.error(None, f"missing shape: one of {', '.join(OBJECT_KINDS)}")
         return kinds[0]
@@ -215,7 +267,7 @@ class ObjectBuilder:
     @staticmethod
     def _shape_params(p: Params, kind: str) -> Params:
         if p.node[kind] is None:
-            p.read.add(kind)
+            p.known(kind)
             empty = type(p.node)()
             empty.where, empty.key_where, empty.value_where = p.node.value_where[kind], {}, {}
             empty.folder = p.folder
@@ -227,3 +279,4 @@ def _compose(own: tf.Transform | None, parent: tf.Transform | None) -> tf.Transf
     if own is None:
         return parent
     return own if parent is None else own.then(parent)
+

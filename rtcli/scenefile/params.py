@@ -66,6 +66,17 @@ class Params:
     def has(self, key: str) -> bool:
         return key in self.node
 
+    def known(self, *keys: str) -> None:
+        """Mark keys as read: allowed here, but read elsewhere or not at all."""
+        self.read.update(keys)
+
+    def optional(self, key: str) -> "Params | None":
+        """The nested mapping at `key` as Params, or None when the key is absent."""
+        if key not in self.node:
+            self.read.add(key)
+            return None
+        return self.sub(key)
+
     def raw(self, key: str, default=REQUIRED):
         """The value as loaded, marked read; a missing required key is an error."""
         self.read.add(key)

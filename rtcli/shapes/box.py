@@ -13,67 +13,99 @@ from __future__ import annotations
 
 import numpy as np
 
-_NORMALS = np.array([[-1.0, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0], [0, 0, -1], [0, 0, 1]])
-_UV_AXES = np.array([[1, 2], [2, 0], [0, 1]])          # (u, v) axes for faces of axis k
+from rtcli.shapes.base import Param, ParamError, Shape, ShapeKernels
+from rtcli.variants import INF, kernel, maximum, minimum, not_, select
+
+LO, HI = 0, 3                                         # the row: min corner, max corner
+
+
+@kernel
+def axis_slab(lo, hi, o, d):
+    """Entry and exit t of the line through the slab lo <= P_k <= hi: (lo - S_k)/c_k and
+    (hi - S_k)/c_k in order; a line parallel to it (c_k = 0) is inside for all t or none."""
+    t_lo, t_hi = (lo - o) / d, (hi - o) / d
+    within = (o >= lo) & (o <= hi)
+    parallel = d == 0
+    return (select(parallel, select(within, -INF, INF), minimum(t_lo, t_hi)),
+            select(parallel, select(within, INF, -INF), maximum(t_lo, t_hi)))
+
+
+@kernel
+def slabs(s, ox, oy, oz, dx, dy, dz):
+    """(t_near, face_in, t_far, face_out, miss): t_near the last entry over the three slabs,
+    t_far the first exit (the first axis on ties); the ray misses when t_near > t_far.
+    Moving down an axis enters by its max face."""
+    t1x, t2x = axis_slab(s[LO], s[HI], ox, dx)
+    t1y, t2y = axis_slab(s[LO + 1], s[HI + 1], oy, dy)
+    t1z, t2z = axis_slab(s[LO + 2], s[HI + 2], oz, dz)
+    later_y, later_z = t1y > t1x, t1z > maximum(t1x, t1y)
+    t_near = select(later_z, t1z, select(later_y, t1y, t1x))
+    k_in = select(later_z, 2, select(later_y, 1, 0))
+    d_in = select(later_z, dz, select(later_y, dy, dx))
+    sooner_y, sooner_z = t2y < t2x, t2z < minimum(t2x, t2y)
+    t_far = select(sooner_z, t2z, select(sooner_y, t2y, t2x))
+    k_out = select(sooner_z, 2, select(sooner_y, 1, 0))
+    d_out = select(sooner_z, dz, select(sooner_y, dy, dx))
+    face_in = 2 * k_in + select(d_in < 0, 1, 0)
+    face_out = 2 * k_out + select(d_out > 0, 1, 0)
+    return t_near, face_in, t_far, face_out, t_near > t_far
+
+
+@kernel
+def hit(s, pool, ox, oy, oz, dx, dy, dz, t_min, t_max):
+    t_near, face_in, t_far, face_out, miss = slabs(s, ox, oy, oz, dx, dy, dz)
+    front = t_near > t_min
+    t = select(front, t_near, t_far)
+    return select(not_(miss) & (t > t_min) & (t < t_max), t, INF), select(front, face_in, face_out)
+
+
+@kernel
+def spans(s, pool, ox, oy, oz, dx, dy, dz):
+    """One interval [t_near, t_far] per ray (any sign of t), inf where the ray misses."""
+    t_near, face_in, t_far, face_out, miss = slabs(s, ox, oy, oz, dx, dy, dz)
+    return select(miss, INF, t_near), face_in, select(miss, INF, t_far), face_out
+
+
+@kernel
+def normals(s, pool, prim, x, y, z):
+    """The face's outward axis: -1 or +1 along axis prim // 2."""
+    sign, k = select(prim % 2 == 1, 1.0, -1.0), prim // 2
+    nx, ny, nz = select(k == 0, sign, 0.0), select(k == 1, sign, 0.0), select(k == 2, sign, 0.0)
+    return nx, ny, nz, nx, ny, nz
+
+
+@kernel
+def uv(s, pool, prim, x, y, z):
+    qx = (x - s[LO]) / (s[HI] - s[LO])                  # 0..1 across the box
+    qy = (y - s[LO + 1]) / (s[HI + 1] - s[LO + 1])
+    qz = (z - s[LO + 2]) / (s[HI + 2] - s[LO + 2])
+    k = prim // 2
+    return select(k == 0, qy, select(k == 1, qz, qx)), select(k == 0, qz, select(k == 1, qx, qy))
 
 
 def _fmt(v) -> str:
     return "[" + ", ".join(f"{x:g}" for x in v) + "]"
 
 
-class Box:
+class Box(Shape):
+    params = (Param("min", "vector", (-1.0, -1.0, -1.0)), Param("max", "vector", (1.0, 1.0, 1.0)))
+    kernels = ShapeKernels(hit, normals, uv, spans)
+
     def __init__(self, lo=(-1.0, -1.0, -1.0), hi=(1.0, 1.0, 1.0)):
         self.lo = np.asarray(lo, dtype=float)           # min corner
         self.hi = np.asarray(hi, dtype=float)           # max corner
+        if not np.all(self.lo < self.hi):
+            raise ParamError("max", f"must be > min in every component, got min {_fmt(self.lo)}, "
+                                    f"max {_fmt(self.hi)}")
+        self.row = np.concatenate([self.lo, self.hi])
 
     @classmethod
-    def from_params(cls, p) -> "Box":
-        lo, hi = p.vector("min", (-1, -1, -1)), p.vector("max", (1, 1, 1))
-        if not np.all(lo < hi):
-            raise p.error("max", f"must be > min in every component, got min {_fmt(lo)}, max {_fmt(hi)}")
-        return cls(lo, hi)
-
-    def _slabs(self, o, d):
-        """Entry and exit of S + c t through the three slabs lo_k <= P_k <= hi_k.
-
-        Per axis t = (lo_k - S_k)/c_k and (hi_k - S_k)/c_k; a ray parallel to a slab
-        (c_k = 0) is inside it for all t or for none. t_near = max over the axes of
-        the entries, t_far = min of the exits; the ray misses when t_near > t_far.
-        Returns t_near, face_in, t_far, face_out, miss.
-        """
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t_lo, t_hi = (self.lo - o) / d, (self.hi - o) / d
-        parallel, within = d == 0, (o >= self.lo) & (o <= self.hi)
-        t1 = np.where(parallel, np.where(within, -np.inf, np.inf), np.minimum(t_lo, t_hi))
-        t2 = np.where(parallel, np.where(within, np.inf, -np.inf), np.maximum(t_lo, t_hi))
-        rows = np.arange(len(o))
-        k_in, k_out = np.argmax(t1, axis=1), np.argmin(t2, axis=1)
-        t_near, t_far = t1[rows, k_in], t2[rows, k_out]
-        face_in = 2 * k_in + (d[rows, k_in] < 0)       # moving down an axis enters by its max face
-        face_out = 2 * k_out + (d[rows, k_out] > 0)
-        return t_near, face_in, t_far, face_out, t_near > t_far
-
-    def intersect(self, o, d, t_min, t_max):
-        t_near, face_in, t_far, face_out, miss = self._slabs(o, d)
-        front = t_near > t_min
-        t = np.where(front, t_near, t_far)
-        t = np.where(~miss & (t > t_min) & (t < t_max), t, np.inf)
-        return t, np.where(front, face_in, face_out)
-
-    def spans(self, o, d):
-        """One interval [t_near, t_far] per ray (any sign of t), inf where the ray misses."""
-        t_near, face_in, t_far, face_out, miss = self._slabs(o, d)
-        t_in, t_out = np.where(miss, np.inf, t_near), np.where(miss, np.inf, t_far)
-        return t_in[:, None], face_in[:, None], t_out[:, None], face_out[:, None]
-
-    def normal(self, p, prim):
-        return _NORMALS[prim]
-
-    def uv(self, p, prim):
-        q = (p - self.lo) / (self.hi - self.lo)         # 0..1 across the box
-        axes = _UV_AXES[prim // 2]
-        rows = np.arange(len(p))
-        return np.stack([q[rows, axes[:, 0]], q[rows, axes[:, 1]]], axis=1)
+    def from_values(cls, **values) -> "Box":
+        return cls(values["min"], values["max"])
 
     def bounds(self):
         return self.lo.copy(), self.hi.copy()
+
+    @classmethod
+    def examples(cls) -> list:
+        return [cls(), cls((-1, -0.5, -2), (1, 1, 0.5))]

@@ -12,6 +12,12 @@ children are objects (with `transform:` and `material:`, no `name` needed);
 difference = first child minus all the others. Children must be solids: sphere,
 plane (the half-space behind its normal), box, cylinder, cone, torus or csg.
 The checker texture of a csg is evaluated in the csg's own object space.
+
+Only the numpy engine renders a CSG: merging a variable number of spans per ray
+is sorting and counting over whole arrays, which numpy does at once; the compiled
+engine, one ray at a time, would need per-ray lists of spans (docs/architecture.md).
+So a CSG has no kernels; it answers the numpy engine's methods (Shape.hits, ...)
+from its children's kernels.
 """
 
 from __future__ import annotations
@@ -20,43 +26,44 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.core.transform import Transform, outer_bounds, ray_into
+from rtcli.core.transform import (
+    OBJECT,
+    Transform,
+    affine,
+    linear,
+    normal_to_world,
+    outer_bounds,
+)
+from rtcli.shapes.base import Shape
 
 OPS = ("union", "intersection", "difference")
 
 
 @dataclass(frozen=True)
 class Child:
-    shape: object
+    shape: Shape
     transform: Transform | None     # csg_from_child; None when the child is in csg space
     material: int
 
     def to_child(self, o, d):
-        return ray_into(self.transform, o, d)
+        """Rays (3, n) into the child's space."""
+        if self.transform is None:
+            return o, d
+        m = self.transform.packed
+        return np.array(affine(m, OBJECT, *o)), np.array(linear(m, OBJECT, *d))
 
 
-def csg_from(p, builder, material: int) -> "CSG":
-    ops = [k for k in OPS if p.has(k)]
-    if len(ops) != 1:
-        raise p.error(None, "a csg needs exactly one of: union, intersection, difference")
-    from rtcli.scenefile.params import as_params
-    items = p.items(ops[0])
-    if len(items) < 2:
-        raise p.error(ops[0], f"needs at least 2 objects, got {len(items)}")
-    children = []
-    for item, where, path in items:
-        cp = as_params(item, where, path, "an object (a mapping with a shape key)")
-        shape, t, mat = builder.child(cp, material)
-        if not hasattr(shape, "spans") or not getattr(shape, "capped", True):
-            raise cp.error(None, "a csg child must be a solid: sphere, plane, box, "
-                           "cylinder, cone (capped), torus or csg")
-        children.append(Child(shape, t, mat))
-    return CSG(ops[0], children)
+class CSG(Shape):
+    kernels = None
 
-
-class CSG:
     def __init__(self, op: str, children: list[Child]):
+        if op not in OPS:
+            raise ValueError(f"unknown csg operation {op!r}")
         self.op, self.children = op, list(children)
+
+    @property
+    def solid(self) -> bool:
+        return True
 
     def _result(self, inside: np.ndarray) -> np.ndarray:
         """The boolean op on per-child inside flags (..., C)."""
@@ -71,7 +78,7 @@ class CSG:
         C = len(self.children)
         ts, deltas, owners, prims = [], [], [], []
         for c, child in enumerate(self.children):
-            t_in, p_in, t_out, p_out = child.shape.spans(*child.to_child(o, d))
+            t_in, p_in, t_out, p_out = child.shape.spans_of(*child.to_child(o, d))
             valid = t_in < t_out
             ts += [np.where(valid, t_in, np.inf), np.where(valid, t_out, np.inf)]
             deltas += [valid.astype(np.int64), -valid.astype(np.int64)]
@@ -80,7 +87,7 @@ class CSG:
         return (np.concatenate(ts, axis=1), np.concatenate(deltas, axis=1),
                 np.concatenate(owners), np.concatenate(prims, axis=1))
 
-    def spans(self, o, d):
+    def spans_of(self, o, d):
         t, delta, owner, prim = self._events(o, d)
         order = np.lexsort((-delta, t), axis=1)         # by t; at equal t, entries before exits
         t, delta, prim = (np.take_along_axis(a, order, axis=1) for a in (t, delta, prim))
@@ -88,56 +95,61 @@ class CSG:
         inside = np.stack([np.cumsum(np.where(owner == c, delta, 0), axis=1) > 0
                            for c in range(len(self.children))], axis=-1)
         now = self._result(inside)
-        before = np.concatenate([np.zeros((len(o), 1), bool), now[:, :-1]], axis=1)
+        before = np.concatenate([np.zeros((o.shape[1], 1), bool), now[:, :-1]], axis=1)
         t_in, p_in = _compact(now & ~before, t, prim)
         t_out, p_out = _compact(~now & before, t, prim)
         return t_in, p_in, t_out, p_out
 
-    def intersect(self, o, d, t_min, t_max):
-        t_in, p_in, t_out, p_out = self.spans(o, d)
+    def hits(self, o, d, t_min, t_max):
+        t_in, p_in, t_out, p_out = self.spans_of(o, d)
         t, prim = np.concatenate([t_in, t_out], axis=1), np.concatenate([p_in, p_out], axis=1)
         t = np.where((t > np.reshape(t_min, (-1, 1))) & (t < np.reshape(t_max, (-1, 1))), t, np.inf)
         k = np.argmin(t, axis=1)
-        rows = np.arange(len(o))
+        rows = np.arange(o.shape[1])
         return t[rows, k], prim[rows, k]
 
     def _per_child(self, p, prim, what):
-        """Evaluate `what(child, p_child, child_prim)` for each hit, grouped by child."""
+        """Evaluate `what(c, child, p_child, child_prim)` -> (k, n_c) for each hit, grouped by child."""
         C = len(self.children)
         owner, child_prim = prim % C, prim // C
         out = None
         for c in np.unique(owner):
             rows = owner == c
             child = self.children[c]
-            p_c = p[rows] if child.transform is None else child.transform.inverse.point(p[rows])
-            value = what(c, child, p_c, child_prim[rows])
+            p_c = p[:, rows] if child.transform is None else np.array(affine(child.transform.packed, OBJECT,
+                                                                             *p[:, rows]))
+            value = np.asarray(what(c, child, p_c, child_prim[rows]))
             if out is None:
-                out = np.empty((len(p),) + value.shape[1:], value.dtype)
-            out[rows] = value
+                out = np.empty(value.shape[:-1] + (p.shape[1],), value.dtype)
+            out[..., rows] = value
         return out
 
-    def normal(self, p, prim):
+    def normals_at(self, p, prim):
         def outward(c, child, p_c, cp):
-            n = child.shape.normal(p_c, cp)
-            n = n if child.transform is None else child.transform.normal(n)
-            return -n if self.op == "difference" and c > 0 else n
-        return self._per_child(p, prim, outward)
+            n, g = child.shape.normals_at(p_c, cp)
+            if child.transform is not None:
+                m = child.transform.packed
+                n, g = np.array(normal_to_world(m, 0, *n)), np.array(normal_to_world(m, 0, *g))
+            flip = -1.0 if self.op == "difference" and c > 0 else 1.0
+            return np.stack([flip * n, flip * g])
+        both = self._per_child(p, prim, outward)
+        return both[0], both[1]
 
-    def uv(self, p, prim):
-        return self._per_child(p, prim, lambda c, child, p_c, cp: child.shape.uv(p_c, cp))
+    def uv_at(self, p, prim):
+        uv = self._per_child(p, prim, lambda c, child, p_c, cp: np.stack(child.shape.uv_at(p_c, cp)))
+        return uv[0], uv[1]
 
     def material_of(self, prim, default: int):
         """Each hit's material: the child's (a nested csg asks its own children).
 
-        `default` (the object's material) is already each child's default, from build.
+        `default` (the object's material) is already each child's default, from the builder.
         """
         C = len(self.children)
         out = np.empty(len(prim), dtype=np.int64)
         for c in np.unique(prim % C):
             rows = prim % C == c
             child = self.children[c]
-            nested = getattr(child.shape, "material_of", None)
-            out[rows] = nested(prim[rows] // C, child.material) if nested else child.material
+            out[rows] = child.shape.material_of(prim[rows] // C, child.material)
         return out
 
     def bounds(self):

@@ -1,8 +1,9 @@
-"""Triangle mesh read from a Wavefront OBJ file, intersected through its own BVH.
+"""Triangle mesh (from a Wavefront OBJ file), hit through its own BVH.
 
 YAML: `mesh: {file: model.obj, smooth: false}`; `file` is relative to the scene
-file's folder. Triangles with zero area are skipped; `prim` is the index of a
-kept triangle, in file order.
+file's folder (the scene-file builder reads it; a Mesh is built from the arrays).
+Triangles with zero area are skipped; `prim` is the index of a kept triangle, in
+file order.
 
 Normals: flat (smooth: false) = the face normal, outward by the vertex order
 (right-hand rule, as `triangle`). Smooth = the file's vn interpolated with the
@@ -11,109 +12,98 @@ normals (the sum of the adjacent faces' (b - a) x (c - a)).
 (u, v): the file's vt interpolated where the face has them, else the
 barycentric coordinates (alpha, beta) of notes 000 11.3.1, as `triangle`.
 
-A mesh has no `spans`: it need not be closed, so it cannot take part in CSG.
+The faces are triangle rows of the pool (triangle.py), with the triangle's normal and
+(u, v) kernels. A mesh has no hit kernel of its own: it is hit through a BVH over its
+faces, walked with triangle_t as the leaf test (numpy's level-by-level walk here, the
+compiled per-ray walk in rtcli/core/bvh.py). A mesh has no spans: it need not be
+closed, so it cannot take part in CSG.
 """
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
-from rtcli import kernels
 from rtcli.core.bvh import BVH
-from rtcli.core.vec import cross, length
-from rtcli.scenefile.obj import read_obj
-from rtcli.shapes.planar import barycentric, degenerate, triangle_solve
+from rtcli.core.vec import cross3, length3
+from rtcli.shapes.base import Param, ParamError, Shape, ShapeKernels
+from rtcli.shapes.triangle import (
+    FIRST,
+    ROOT,
+    degenerate,
+    normals,
+    triangle_rows,
+    triangle_t,
+    uv,
+)
+from rtcli.variants import INF, select
 
 
-class Mesh:
+class Mesh(Shape):
     """Triangles a, b, c = vertices[faces]; optional per-corner vt / vn (index -1: none)."""
+
+    params = (Param("file", "obj"), Param("smooth", "boolean", False))
+    kernels = ShapeKernels(None, normals, uv)
+    FIRST_COLUMN = FIRST
+    ROOT_COLUMN = ROOT
 
     def __init__(self, vertices, faces, smooth=False, uv=None, uv_faces=None, normals=None, normal_faces=None):
         v, f = np.asarray(vertices, dtype=float).reshape(-1, 3), np.asarray(faces, dtype=np.int64).reshape(-1, 3)
         if len(f) == 0:
-            raise ValueError("the mesh has no faces")
+            raise ParamError("file", "the mesh has no faces")
         a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
         keep = ~degenerate(a, b, c)                                        # as triangle: not collinear
         if not keep.any():
-            raise ValueError("all triangles of the mesh have zero area")
-        self.a, self.e1, self.e2 = a[keep], (b - a)[keep], (c - a)[keep]
-        self.face = cross(self.e1, self.e2)                                # outward, |face| = 2 area
-        self.uv_corners = _corners(uv, uv_faces, keep)                     # (F, 3, 2) or None
-        self.normal_corners = (_smooth_normals(v, f[keep], self.face, normals, normal_faces, keep)
-                               if smooth else None)                       # (F, 3, 3) or None
-        self.bvh = BVH(np.minimum(np.minimum(a, b), c)[keep], np.maximum(np.maximum(a, b), c)[keep])
+            raise ParamError("file", "all triangles of the mesh have zero area")
+        a, b, c = a[keep], b[keep], c[keep]
+        uvs = _corners(uv, uv_faces, keep)                                 # (F, 3, 2) or None
+        corner_normals = _smooth_normals(v, f[keep], cross3(b - a, c - a), normals, normal_faces, keep) \
+            if smooth else None
+        self.pool = triangle_rows(a, b, c, corner_normals, uvs)
+        self.bvh = BVH(np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c))
+        self.row = np.array([0.0, float(smooth), float(uvs is not None), 0.0])
+        self.smooth = bool(smooth)
 
     @classmethod
-    def from_params(cls, p):
-        name, smooth = p.string("file"), p.boolean("smooth", False)
-        path = os.path.normpath(os.path.join(p.folder, name))
-        try:
-            data = read_obj(path)
-        except FileNotFoundError:
-            raise p.error("file", f"file not found: {path}") from None
-        except OSError as e:
-            raise p.error("file", f"cannot read {path}: {e.strerror}") from None
-        try:
-            return cls(data.vertices, data.faces, smooth, data.uv, data.uv_faces, data.normals, data.normal_faces)
-        except ValueError as e:
-            raise p.error("file", f"{e}: {path}") from None
+    def from_values(cls, file, smooth=False) -> "Mesh":
+        """From an OBJ file's arrays (rtcli.scenefile.obj.ObjData)."""
+        return cls(file.vertices, file.faces, smooth, file.uv, file.uv_faces, file.normals, file.normal_faces)
 
-    # --- intersection ---
-    def intersect(self, o, d, t_min, t_max):
-        """Nearest triangle hit in (t_min, t_max): (t, prim), inf and -1 for a miss."""
-        if kernels.available():
-            return kernels.traverse(self.bvh, o, d, t_min, t_max, 0, self.a, self.e1, self.e2)
-        return self.bvh.intersect(o, d, t_min, t_max, self._pair_test(o, d, t_min))
-
-    def any_hit(self, o, d, t_min, t_max):
-        """(n,) bool: some triangle is hit in (t_min, t_max) (shadow feelers)."""
-        if kernels.available():
-            return kernels.traverse(self.bvh, o, d, t_min, t_max, 0, self.a, self.e1, self.e2, any_hit=True)
-        return self.bvh.any_hit(o, d, t_min, t_max, self._pair_test(o, d, t_min))
-
-    def _pair_test(self, o, d, t_min):
-        """The BVH's callback: rays r against triangles p, pair by pair."""
-        o, d, t_min = np.asarray(o, dtype=float), np.asarray(d, dtype=float), np.asarray(t_min, dtype=float)
-
-        def hit_pairs(r, p, t_max):
-            t, alpha, beta = triangle_solve(o[r], d[r], self.a[p], self.e1[p], self.e2[p])
-            lo = t_min if t_min.ndim == 0 else t_min[r]
-            inside = (alpha >= 0) & (beta >= 0) & (alpha + beta <= 1)
-            return np.where(inside & (t > lo) & (t < t_max), t, np.inf)
-        return hit_pairs
-
-    # --- surface ---
-    def barycentric(self, p, prim):
-        """(alpha, beta) of points p in the planes of triangles prim (weights of b and c)."""
-        return barycentric(p - self.a[prim], self.e1[prim], self.e2[prim])
-
-    def geometric_normal(self, p, prim):
-        return self.face[prim]
-
-    def normal(self, p, prim):
-        if self.normal_corners is None:
-            return self.face[prim]
-        n = _interpolate(self.normal_corners[prim], *self.barycentric(p, prim))
-        return np.where(length(n)[:, None] > 0, n, self.face[prim])
-
-    def uv(self, p, prim):
-        alpha, beta = self.barycentric(p, prim)
-        bary = np.stack([alpha, beta], axis=1)
-        if self.uv_corners is None:
-            return bary
-        uv = _interpolate(self.uv_corners[prim], alpha, beta)
-        return np.where(np.isnan(uv), bary, uv)                       # faces without vt
+    def __len__(self) -> int:
+        return len(self.pool)
 
     def bounds(self):
         return self.bvh.bounds()
 
+    # --- the numpy walk (the compiled one: rtcli.core.bvh.walk) ---
+    def hits(self, o, d, t_min, t_max):
+        """Nearest triangle hit in (t_min, t_max) of rays o, d (3, n): (t, prim), inf and -1 for a miss."""
+        return self.bvh.intersect(o, d, t_min, t_max, self.pair_test(o, d, t_min))
 
-def _interpolate(corners, alpha, beta):
-    """(1 - alpha - beta) x corner a + alpha x corner b + beta x corner c; corners (n, 3, k)."""
-    return ((1 - alpha - beta)[:, None] * corners[:, 0] + alpha[:, None] * corners[:, 1]
-            + beta[:, None] * corners[:, 2])
+    def any_hit(self, o, d, t_min, t_max) -> np.ndarray:
+        """(n,) bool: some triangle is hit in (t_min, t_max) (shadow feelers); o, d (3, n)."""
+        return self.bvh.any_hit(o, d, t_min, t_max, self.pair_test(o, d, t_min))
+
+    def pair_test(self, o, d, t_min):
+        """The BVH's callback for rays o, d (3, n): rays r against triangles p, pair by pair."""
+        t_min = np.asarray(t_min, dtype=float)
+
+        def hit_pairs(r, p, t_max):
+            with np.errstate(all="ignore"):
+                t = triangle_t(self.pool, p, *o[:, r], *d[:, r])
+            lo = t_min if t_min.ndim == 0 else t_min[r]
+            return select((t > lo) & (t < t_max), t, INF)
+        return hit_pairs
+
+    @classmethod
+    def examples(cls) -> list:
+        """A closed octahedron, flat and smooth, and a random soup of triangles with (u, v)s."""
+        v = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+        f = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+        rng = np.random.default_rng(3)
+        soup = rng.normal(size=(90, 3))
+        return [cls(v, f), cls(v * [1, 0.7, 1.3], f, smooth=True),
+                cls(soup, np.arange(90).reshape(30, 3), uv=rng.uniform(0, 1, (90, 2)),
+                    uv_faces=np.arange(90).reshape(30, 3))]
 
 
 def _corners(values, index, keep):
@@ -131,9 +121,9 @@ def _smooth_normals(v, faces, face, normals, normal_faces, keep):
     summed = np.stack([np.bincount(faces.ravel(), weights=np.repeat(face[:, j], 3), minlength=len(v))
                        for j in range(3)], axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        out = np.nan_to_num(summed / length(summed)[:, None])[faces]
+        out = np.nan_to_num(summed / length3(summed)[:, None])[faces]
         given = _corners(normals, normal_faces, keep)
         if given is not None:
-            given = given / length(given)[..., None]
+            given = given / length3(given)[..., None]
             out = np.where(np.isnan(given), out, given)
     return np.nan_to_num(out)

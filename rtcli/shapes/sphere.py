@@ -6,66 +6,95 @@ YAML: `sphere: {center: [0, 0, 0], radius: 1}`; both optional (the generic unit 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from rtcli.core.vec import dot
+from rtcli.shapes.base import Param, Shape, ShapeKernels
+from rtcli.variants import (
+    INF,
+    arcsin,
+    arctan2,
+    copysign,
+    isfinite,
+    kernel,
+    maximum,
+    minimum,
+    not_,
+    select,
+    sqrt,
+)
+
+CENTER, RADIUS, RADIUS2 = 0, 3, 4                     # the row: center (3), r, r^2
 
 
-def sphere_roots(S, d, r2):
-    """Roots of A t^2 + 2B t + C = 0, A = |d|^2, B = S.d, C = |S|^2 - r^2, S = o - center.
+@kernel
+def roots(s, ox, oy, oz, dx, dy, dz):
+    """Both roots of A t^2 + 2B t + C = 0, A = |d|^2, B = S.d, C = |S|^2 - r^2, S = o - center.
 
     The notes' t = (-B -+ sqrt(B^2 - AC)) / A, computed as q/A and C/q with
     q = -B - sign(B) sqrt(B^2 - AC), which avoids cancellation. (t_near, t_far), inf on a miss.
     """
-    A, B, C = dot(d, d), dot(S, d), dot(S, S) - r2
+    Sx, Sy, Sz = ox - s[CENTER], oy - s[CENTER + 1], oz - s[CENTER + 2]
+    A, B = dot(dx, dy, dz, dx, dy, dz), dot(Sx, Sy, Sz, dx, dy, dz)
+    C = dot(Sx, Sy, Sz, Sx, Sy, Sz) - s[RADIUS2]
     disc = B * B - A * C
-    root = np.sqrt(np.maximum(disc, 0))
-    q = -B - np.copysign(root, B)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t1, t2 = q / A, C / q
-    t_near, t_far = np.minimum(t1, t2), np.maximum(t1, t2)
-    miss = (disc < 0) | ~np.isfinite(t_near) & ~np.isfinite(t_far)
-    return np.where(miss, np.inf, t_near), np.where(miss, np.inf, t_far)
+    q = -B - copysign(sqrt(maximum(disc, 0.0)), B)
+    t1, t2 = q / A, C / q
+    near, far = minimum(t1, t2), maximum(t1, t2)
+    miss = (disc < 0) | (not_(isfinite(near)) & not_(isfinite(far)))
+    return select(miss, INF, near), select(miss, INF, far)
 
 
-def nearest_root(t_near, t_far, t_min, t_max):
-    """The first root in (t_min, t_max), inf if neither is."""
-    t = np.where(t_near > t_min, t_near, t_far)
-    return np.where((t > t_min) & (t < t_max), t, np.inf)
+@kernel
+def first_root(near, far, t_min, t_max):
+    """The first of two roots in (t_min, t_max), inf if neither is."""
+    t = select(near > t_min, near, far)
+    return select((t > t_min) & (t < t_max), t, INF)
 
 
-def sphere_uv(q):
-    """(u, v) of unit vectors q from the centre: longitude around +y, latitude from the south pole."""
-    u = 0.5 + np.arctan2(q[:, 0], q[:, 2]) / (2 * np.pi)
-    v = 0.5 + np.arcsin(np.clip(q[:, 1], -1, 1)) / np.pi
-    return np.stack([u, v], axis=1)
+@kernel
+def hit(s, pool, ox, oy, oz, dx, dy, dz, t_min, t_max):
+    near, far = roots(s, ox, oy, oz, dx, dy, dz)
+    return first_root(near, far, t_min, t_max), 0
 
 
-class Sphere:
+@kernel
+def spans(s, pool, ox, oy, oz, dx, dy, dz):
+    near, far = roots(s, ox, oy, oz, dx, dy, dz)
+    return near, 0, far, 0
+
+
+@kernel
+def normals(s, pool, prim, x, y, z):
+    """(P - center) / r: unit on the surface."""
+    r = s[RADIUS]
+    nx, ny, nz = (x - s[CENTER]) / r, (y - s[CENTER + 1]) / r, (z - s[CENTER + 2]) / r
+    return nx, ny, nz, nx, ny, nz
+
+
+@kernel
+def uv(s, pool, prim, x, y, z):
+    """Longitude around +y and latitude of the point's direction q from the centre."""
+    r = s[RADIUS]
+    qx, qy, qz = (x - s[CENTER]) / r, (y - s[CENTER + 1]) / r, (z - s[CENTER + 2]) / r
+    return (0.5 + arctan2(qx, qz) / (2 * math.pi),
+            0.5 + arcsin(minimum(maximum(qy, -1.0), 1.0)) / math.pi)
+
+
+class Sphere(Shape):
+    params = (Param("center", "vector", (0.0, 0.0, 0.0)), Param("radius", "number", 1.0, positive=True))
+    kernels = ShapeKernels(hit, normals, uv, spans)
+
     def __init__(self, center=(0.0, 0.0, 0.0), radius: float = 1.0):
         self.center = np.asarray(center, dtype=float)
         self.radius = float(radius)
-
-    @classmethod
-    def from_params(cls, p) -> "Sphere":
-        return cls(p.vector("center", (0, 0, 0)), p.number("radius", 1.0, positive=True))
-
-    def _roots(self, o, d):
-        return sphere_roots(o - self.center, d, self.radius ** 2)
-
-    def intersect(self, o, d, t_min, t_max):
-        return nearest_root(*self._roots(o, d), t_min, t_max), None
-
-    def spans(self, o, d):
-        t_near, t_far = self._roots(o, d)
-        zero = np.zeros((len(o), 1), dtype=np.int64)
-        return t_near[:, None], zero, t_far[:, None], zero
-
-    def normal(self, p, prim):
-        return (p - self.center) / self.radius
-
-    def uv(self, p, prim):
-        return sphere_uv((p - self.center) / self.radius)
+        self.row = np.array([*self.center, self.radius, self.radius ** 2])
 
     def bounds(self):
         return self.center - self.radius, self.center + self.radius
+
+    @classmethod
+    def examples(cls) -> list:
+        return [cls(), cls((0.3, -0.2, 0.1), 1.3)]

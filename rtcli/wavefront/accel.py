@@ -4,19 +4,25 @@ Unbounded objects (planes) are tested against every ray. Bounded objects go
 into one BVH over their world-space boxes; the BVH hands back (ray, object)
 pairs whose boxes the ray meets, and only those pairs are intersected. Spheres
 without a transform, the common case in big scenes, are tested as one
-vectorized batch per step; other objects are grouped per object.
+vectorized batch per step (the sphere kernels take one row of parameters per
+ray); other objects are grouped per object. When every bounded object is such a
+sphere and numba is installed, the compiled per-ray walk of rtcli/core/bvh.py
+does the whole BVH part instead.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from rtcli import kernels
+from rtcli import variants
 from rtcli.core.bvh import BVH
-from rtcli.shapes.sphere import Sphere, nearest_root, sphere_roots
+from rtcli.core.vec import unit
+from rtcli.shapes.sphere import Sphere
+from rtcli.variants import INF, select
 from rtcli.wavefront.intersect import (
     blocked_by,
     blocks,
+    fill_texture,
     nearest_over,
     no_hits,
     object_hit,
@@ -34,22 +40,29 @@ class Accelerator:
         self.members = np.array([k for k, b in enumerate(boxes) if b is not None], dtype=np.int64)
         self.bvh = BVH(np.array([boxes[k][0] for k in self.members]).reshape(-1, 3),
                        np.array([boxes[k][1] for k in self.members]).reshape(-1, 3), leaf_size=2)
-        self.is_sphere = np.array([b is not None and isinstance(o.shape, Sphere) and o.world_from_object is None
+        self.is_sphere = np.array([b is not None and type(o.shape) is Sphere and o.transform is None
                                    for o, b in zip(objects, boxes)], dtype=bool)     # by object index
-        self.center = np.array([o.shape.center if s else np.zeros(3) for o, s in zip(objects, self.is_sphere)])
-        self.radius = np.array([o.shape.radius if s else 1.0 for o, s in zip(objects, self.is_sphere)])
+        self.spheres = np.array([o.shape.row if s else np.zeros(5) for o, s in zip(objects, self.is_sphere)]).T
         self.material = np.array([o.material for o in objects], dtype=np.int64)
         self.shadow = scene.materials.shadow[self.material]
-        self.all_spheres = bool(self.is_sphere[self.members].all())    # the compiled traversal can do it all
-        k = self.members
-        self.kernel_args = (self.center[k], (self.radius[k] ** 2)[:, None], np.ones((len(k), 1)))
-        self.kernel_shadow = (self.center[k], (self.radius[k] ** 2)[:, None],
-                              self.shadow[k].astype(float)[:, None])
+        self.all_spheres = bool(self.is_sphere[self.members].all())    # the compiled walk can do it all
+        self._geometry = None
 
     @staticmethod
     def wanted(scene) -> bool:
         """Whether the scene has enough bounded objects for the BVH to pay."""
         return sum(b is not None for b in scene.boxes) >= MIN_OBJECTS
+
+    def batched(self, obj: np.ndarray) -> np.ndarray:
+        """Which hits (object indices, -1 none) are on untransformed spheres."""
+        return self.is_sphere[obj]
+
+    # --- first hits and feelers ---
+    def _sphere_t(self, o, d, r, k, t_min, t_max):
+        """t of rays r against spheres k (object indices), pair by pair."""
+        with np.errstate(all="ignore"):
+            t, _ = Sphere.kernels.hit(self.spheres[:, k], None, *o[:, r], *d[:, r], t_min, t_max)
+        return t
 
     def _pair_test(self, scene, o, d, t_min, r, m, t_max):
         """(t, prim) of (ray r, member m) pairs in (t_min, t_max)."""
@@ -57,13 +70,11 @@ class Accelerator:
         t, prim = np.full(len(r), np.inf), np.zeros(len(r), dtype=np.int64)
         sph = self.is_sphere[obj]
         if sph.any():
-            k = obj[sph]
-            roots = sphere_roots(o[r[sph]] - self.center[k], d[r[sph]], self.radius[k] ** 2)
-            t[sph] = nearest_root(*roots, t_min, t_max[sph])
+            t[sph] = self._sphere_t(o, d, r[sph], obj[sph], t_min, t_max[sph])
         rest = np.flatnonzero(~sph)
         for k in np.unique(obj[rest]):
             rows = rest[obj[rest] == k]
-            t[rows], prim[rows] = object_hit(scene.objects[k], o[r[rows]], d[r[rows]], t_min, t_max[rows])
+            t[rows], prim[rows] = object_hit(scene.objects[k], o[:, r[rows]], d[:, r[rows]], t_min, t_max[rows])
         return t, prim
 
     def _pair_blocks(self, scene, o, d, r, m):
@@ -72,26 +83,40 @@ class Accelerator:
         blocked = np.zeros(len(r), dtype=bool)
         sph = self.shadow[obj] & self.is_sphere[obj]
         if sph.any():
-            k = obj[sph]
-            roots = sphere_roots(o[r[sph]] - self.center[k], d[r[sph]], self.radius[k] ** 2)
-            blocked[sph] = np.isfinite(nearest_root(*roots, 0.0, 1.0))
+            blocked[sph] = np.isfinite(self._sphere_t(o, d, r[sph], obj[sph], 0.0, 1.0))
         rest = np.flatnonzero(self.shadow[obj] & ~sph)
         for k in np.unique(obj[rest]):
             rows = rest[obj[rest] == k]
-            blocked[rows] = blocks(scene.objects[k], o[r[rows]], d[r[rows]], 0.0, 1.0)
-        return np.where(blocked, 0.5, np.inf)
+            blocked[rows] = blocks(scene.objects[k], o[:, r[rows]], d[:, r[rows]], 0.0, 1.0)
+        return select(blocked, 0.5, INF)
+
+    def _walk(self, scene, o, d, t_min, t_max, shadow: bool):
+        """The compiled walk over the scene's tree: (t, object, prim) per ray."""
+        from rtcli.compiled import query
+        from rtcli.compiled.pack import geometry
+        if self._geometry is None:
+            self._geometry = geometry(scene)
+        geo, depth = self._geometry
+        n = o.shape[1]
+        t, obj, prim = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
+        lo, hi = (np.broadcast_to(np.asarray(x, float), (n,)).copy() for x in (t_min, t_max))
+        query.WALK_RAYS_OBJECTS(geo, 0, np.ascontiguousarray(o), np.ascontiguousarray(d), lo, hi, shadow,
+                                t, obj, prim, np.empty(depth, np.int64))
+        return t, obj, prim
 
     def first_hit(self, scene, rays, t_min):
         """find_first_hit through the BVH."""
-        o, d = rays.origin, rays.direction
+        o, d = rays.o, rays.d
         hits = no_hits(len(rays))
         nearest_over(scene, self.unbounded, rays, t_min, hits)
+        if variants.ENABLED and self.all_spheres:
+            t, obj, sub = self._walk(scene, o, d, t_min, hits.t, False)
+            won = obj >= 0
+            hits.t[won], hits.obj[won], hits.prim[won] = t[won], obj[won], sub[won]
+            return hits
         sub = np.zeros(len(rays), dtype=np.int64)      # which face of the winning object (0 for spheres)
-        if kernels.available() and self.all_spheres:
-            t, member = kernels.traverse(self.bvh, o, d, t_min, hits.t, 1, *self.kernel_args)
-        else:
-            pairs = lambda r, m, t_max: self._pair_test(scene, o, d, t_min, r, m, t_max)
-            t, member = self.bvh.intersect(o, d, t_min, hits.t, pairs, sub)
+        pairs = lambda r, m, t_max: self._pair_test(scene, o, d, t_min, r, m, t_max)
+        t, member = self.bvh.intersect(o, d, t_min, hits.t, pairs, sub)
         won = member >= 0
         hits.t[won], hits.obj[won], hits.prim[won] = t[won], self.members[member[won]], sub[won]
         return hits
@@ -99,12 +124,23 @@ class Accelerator:
     def occluded(self, scene, points, lights):
         """occluded() through the BVH: feelers stop at their first blocker."""
         d = lights - points
-        blocked = np.zeros(len(points), dtype=bool)
+        blocked = np.zeros(points.shape[1], dtype=bool)
         blocked_by(scene, self.unbounded, points, d, blocked)
         todo = np.flatnonzero(~blocked)
-        p, dt = points[todo], d[todo]
-        if kernels.available() and self.all_spheres:
-            blocked[todo] = kernels.traverse(self.bvh, p, dt, 0.0, 1.0, 1, *self.kernel_shadow, any_hit=True)
+        p, dt = points[:, todo], d[:, todo]
+        if variants.ENABLED and self.all_spheres:
+            blocked[todo] = self._walk(scene, p, dt, 0.0, 1.0, True)[1] >= 0
         else:
             blocked[todo] = self.bvh.any_hit(p, dt, 0.0, 1.0, lambda r, m, t_max: self._pair_blocks(scene, p, dt, r, m))
         return blocked
+
+    # --- surfaces ---
+    def sphere_surface(self, scene, p, obj, rows, normal, geometric, material, texture) -> None:
+        """Fill the surface arrays at `rows` for hits p (3, n) on untransformed spheres obj."""
+        rows_of = self.spheres[:, obj]
+        with np.errstate(all="ignore"):
+            n = unit(*Sphere.kernels.normals(rows_of, None, 0, *p)[:3])
+        normal[:, rows] = geometric[:, rows] = n
+        material[rows] = self.material[obj]
+        fill_texture(scene, p, lambda sel: Sphere.kernels.uv(rows_of[:, sel], None, 0, *p[:, sel]), material[rows],
+                     texture, rows)

@@ -1,60 +1,50 @@
-"""The local term of the shading equation (SCENE_FORMAT.md; notes 000 11.7, 002, 004):
+"""The local term of the shading equation on arrays of hits (docs/scene-format.md, Shading):
 
     emission + ka Ia T + sum over lights not in shadow with N.L > 0:
                          att(r) I (kd T (N.L) + ks spec)
 
-spec = max(0, R.V)^n with R = 2(N.L)N - L (phong), or max(0, N.H)^n with
-H = norm(L + V) (blinn). Products of colors are per channel.
+The formulas are the kernels of rtcli/core/shading.py and rtcli/core/lights.py; this
+module chooses what to compute for which hits: only the lit rows get a shadow feeler,
+only the shiny ones a specular term.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from rtcli.core.lights import COLOR, sample_point, toward, weight
 from rtcli.core.scene import Scene
-from rtcli.core.vec import dot, normalize
+from rtcli.core.shading import ambient, diffuse, specular, specular_cos
+from rtcli.core.vec import dot, unit
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import Surface, occluded
 from rtcli.wavefront.rays import Rays
 
 
-def specular(N, L, V, NL, NV, n, model: str) -> np.ndarray:
-    """spec for unit N, L, V (NL = N.L, NV = N.V) and exponents n.
-
-    phong: R.V with R = 2(N.L)N - L, so R.V = 2(N.L)(N.V) - L.V; blinn: N.H, H = norm(L + V).
-    """
-    if model == "blinn":
-        H = L + V
-        cos = dot(N, H) / np.sqrt(dot(H, H))
-    else:
-        cos = 2 * NL * NV - dot(L, V)
-    return np.maximum(cos, 0) ** n
-
-
 def local(scene: Scene, rays: Rays, s: Surface, stats: Stats) -> np.ndarray:
-    """Emission, ambient and direct light at each surface point."""
-    m, table = s.material, scene.materials
-    kd_T, ks, n = table.kd[m] * s.texture, table.ks[m], table.n[m]
-    color = table.emission[m] + table.ka[m] * scene.ambient * s.texture
-    V = -normalize(rays.direction)
-    NV = dot(s.n, V)
+    """Emission, ambient and direct light at each surface point: colors (3, n)."""
+    m, table, T, N = s.material, scene.materials, s.texture, s.n
+    color = np.array(ambient(table, m, scene.ambient, *T))
+    V = -np.array(unit(*rays.d))
+    NV = dot(*N, *V)
     shiny = table.shiny[m]                               # spec is only worked out where ks > 0
     start = s.p + scene.offset * s.ng                    # feelers leave from the lit side
-    for light in scene.lights:
-        points = light.sample_points(s.p)
-        for lp in points:
-            to_light = lp - s.p
-            r = np.sqrt(dot(to_light, to_light))
-            L = to_light / r[:, None]
-            NL = dot(s.n, L)
+    blinn = scene.settings.specular == "blinn"
+    for light, row in zip(scene.lights, scene.light_rows):
+        I = row[COLOR:COLOR + 3]
+        for cell in range(light.samples):
+            q = np.array(np.broadcast_arrays(*sample_point(row, cell, *s.p), s.p[0]))[:3]
+            *L, r = toward(*q, *s.p)
+            L = np.array(L)
+            NL = dot(*N, *L)
             lit = np.flatnonzero(NL > 0)                 # N.L <= 0: no contribution (004, case 2)
             stats.shadow += len(lit)
-            lit = lit[~occluded(scene, start[lit], lp[lit])]
-            weight = light.attenuate(r[lit]) * light.spot_factor(L[lit]) / len(points)
-            color[lit] += (weight * NL[lit])[:, None] * light.color * kd_T[lit]
-            hl = lit[shiny[lit]]
+            lit = lit[~occluded(scene, start[:, lit], q[:, lit])]
+            w = weight(row, r[lit], *L[:, lit], light.samples)
+            color[:, lit] += diffuse(table, m[lit], I, w, NL[lit], *T[:, lit])
+            spec = shiny[lit]
+            hl = lit[spec]
             if len(hl):
-                spec = specular(s.n[hl], L[hl], V[hl], NL[hl], NV[hl], n[hl], scene.settings.specular)
-                w = weight[shiny[lit]] * spec
-                color[hl] += w[:, None] * light.color * ks[hl]
+                cos = specular_cos(blinn, *N[:, hl], *L[:, hl], *V[:, hl], NL[hl], NV[hl])
+                color[:, hl] += specular(table, m[hl], I, w[spec], cos)
     return color

@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from rtcli import compiled as fast
-from rtcli import kernels
+from rtcli import variants
 from rtcli.errors import RtcliError
 from rtcli.render import Job, render, render_tile
 from rtcli.scenefile.build import load_scene
 from rtcli.wavefront.accel import Accelerator
 
-pytestmark = pytest.mark.skipif(not kernels.ENABLED, reason="numba is not installed")
+pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = sorted((ROOT / "scenes").glob("*.yaml")) + sorted((ROOT / "bench").glob("*.yaml"))
@@ -31,12 +31,12 @@ def both(scene, width=96, height=72, **job):
     return a, b, sa, sb
 
 
-def test_the_supported_scenes_cover_every_compiled_shape():
-    kinds = {type(o.shape).__name__ for p in SUPPORTED for o in load_scene(str(p)).objects}
-    assert {"Sphere", "Plane", "Box", "Cylinder", "Cone", "Mesh", "Triangle", "Polygon"} <= kinds
-    assert any(o.shape.normal_corners is not None for p in SUPPORTED for o in load_scene(str(p)).objects
-               if type(o.shape).__name__ == "Mesh")
-    assert len(SUPPORTED) >= 17
+def test_the_supported_scenes_cover_every_shape_of_the_registry():
+    from rtcli.shapes import SHAPES
+    objects = [o for p in SUPPORTED for o in load_scene(str(p)).objects]
+    assert set(SHAPES.values()) - {type(o.shape) for o in objects} <= {SHAPES["square"]}    # square: below
+    assert any(o.kind == "mesh" and o.shape.smooth for o in objects)
+    assert len(SUPPORTED) == len(SCENES) - 1                                              # all but csg
 
 
 @pytest.mark.parametrize("path", SUPPORTED, ids=lambda p: f"{p.parent.name}/{p.stem}")
@@ -97,6 +97,7 @@ objects:
       normals: [[-1, 0.2, -1], [1, 0.3, -1], [0, 1, -0.5]]
     material: glass
   - {polygon: {vertices: [[-3, -1, 3], [-1.5, -1, 3], [-2.2, 0, 3], [-1.5, 1, 3], [-3, 1, 3]]}, material: checks}
+  - {torus: {major: 0.5, minor: 0.2}, material: mirror, transform: [{rotate: {axis: [1, 0.3, 0], degrees: 60}}, {translate: [2.6, 1.7, -1.2]}]}
 """
 
 
@@ -154,8 +155,7 @@ def test_many_objects_go_through_the_scene_bvh(yaml_scene):
 def test_unsupported_names_what_the_compiled_engine_lacks():
     reasons = {p.stem: fast.unsupported(load_scene(str(p))) for p in SCENES}
     assert reasons["csg"] == "csg objects"
-    assert reasons["torus"] == "torus objects"
-    assert reasons["whitted"] is None
+    assert reasons["torus"] is None and reasons["whitted"] is None
 
 
 def test_choose_falls_back_to_numpy_or_says_why(monkeypatch):
@@ -167,29 +167,31 @@ def test_choose_falls_back_to_numpy_or_says_why(monkeypatch):
     assert fast.choose(whitted, "numpy") is None
     assert fast.choose(whitted, "auto", rays=fast.AUTO_RAYS - 1) is None     # small jobs: no numba start-up
     assert isinstance(fast.choose(whitted, "auto"), fast.Compiled)
-    monkeypatch.setattr(kernels, "ENABLED", False)
+    monkeypatch.setattr(variants, "ENABLED", False)
     assert fast.choose(whitted, "auto") is None
     with pytest.raises(RtcliError, match="numba is not installed"):
         fast.choose(whitted, "compiled")
 
 
 def test_a_source_change_drops_the_cached_machine_code(tmp_path, monkeypatch):
-    """numba alone would keep machine code built from an older shapes.py inside integrator's cache."""
-    package = tmp_path / "fast"
-    (package / "__pycache__").mkdir(parents=True)
-    for name in fast.SOURCES:
-        (package / name).write_text(f"# {name}\n")
-    stale = package / "__pycache__" / "integrator.trace_rays-1.py311.nbi"
-    stale.write_text("old")
-    monkeypatch.setattr(fast, "__file__", str(package / "__init__.py"))
-    fast._drop_stale_cache()
-    assert not stale.exists()
-    stale.write_text("new")
-    fast._drop_stale_cache()                      # same sources: the cache stays
-    assert stale.exists()
-    (package / "shapes.py").write_text("# changed\n")
-    fast._drop_stale_cache()
-    assert not stale.exists()
+    """numba alone would keep machine code built from an older sphere.py inside the integrator's cache."""
+    package = tmp_path / "rtcli"
+    for folder in ("core", "shapes", "compiled"):
+        (package / folder / "__pycache__").mkdir(parents=True)
+        (package / folder / "a.py").write_text(f"# {folder}\n")
+    (package / "variants.py").write_text("# ops\n")
+    stale = [package / folder / "__pycache__" / "a.f-1.py311.nbi" for folder in ("core", "shapes", "compiled")]
+    monkeypatch.setattr(fast, "PACKAGE", package)
+
+    def cache(text):
+        for f in stale:
+            f.write_text(text)
+        fast.drop_stale_cache()
+        return [f.exists() for f in stale]
+    assert cache("old") == [False] * 3
+    assert cache("new") == [True] * 3              # same sources: the cache stays
+    (package / "shapes" / "a.py").write_text("# a changed kernel\n")
+    assert cache("newer") == [False] * 3
 
 
 def test_image_textures_on_every_shape(yaml_scene, tmp_path):
@@ -212,6 +214,7 @@ def test_image_textures_on_every_shape(yaml_scene, tmp_path):
           - {square: {}, material: clamped, transform: [{translate: [-1, 1.8, 1.5]}]}
           - {triangle: {vertices: [[0.5, -1, 2], [2, -1, 2], [1.2, 0.5, 2]]}, material: tiled}
           - {polygon: {vertices: [[-3.5, -1, 2.5], [-2, -1, 2.5], [-2.6, 0, 2.5], [-2, 1, 2.5], [-3.5, 1, 2.5]]}, material: clamped}
+          - {torus: {major: 0.5, minor: 0.25}, material: tiled, transform: [{rotate: {axis: [1, 0, 0], degrees: 70}}, {translate: [-1.5, -0.4, -1.5]}]}
         """)
     ids, _ = render(scene, Job(120, 90, signature=True))
     assert set(range(1, len(scene.objects) + 1)) <= set(np.unique(ids).tolist())
@@ -253,7 +256,7 @@ def test_corner_normals_that_cancel_fall_back_to_the_face(yaml_scene):
         """)
     a, b, sa, sb = both(scene, 97, 73)
     assert np.array_equal(a, b) and sa.refracted == sb.refracted
-    assert np.isfinite(scene.objects[0].shape.normal(np.zeros((1, 3)), None)).all()
+    assert np.isfinite(scene.objects[0].shape.normal(np.zeros((1, 3)), np.array([0]))).all()
 
 
 def test_loading_the_engine_skips_numbas_blas_lookup_and_leaves_no_trace():

@@ -1,0 +1,337 @@
+"""One source for the physics, several variants: a kernel is written once and run on
+numpy arrays (the wavefront engine) or one ray at a time (the compiled engine).
+
+A kernel is a plain function whose per-ray inputs are floats or (n,) arrays, written
+with a small vocabulary (this module): arithmetic and comparisons, `&` `|` and
+`not_` on masks, `select(mask, a, b)` where code would branch on a per-ray value,
+and the math functions below. An `if` is allowed only on values that are the same
+for every ray of a call (a shape's parameters, a light's kind). Kernels call other
+kernels by the names they import, and return tuples of components: (x, y, z), not
+(n, 3) arrays. This is how Mitsuba 3 writes `Sphere<Float, Spectrum>` once for its
+scalar and vectorized variants, and how pbrt-v4 shares shapes between its CPU and
+GPU integrators.
+
+The variants of a kernel `f`:
+- `f` itself, as imported: the numpy variant. Its ops are numpy's ufuncs, so it runs
+  on whole arrays (and on numpy scalars).
+- `python(f)`: plain Python on floats, one ray at a time. The easiest to step
+  through in a debugger, and needs no numba.
+- `compiled(f)`: the same scalar code compiled by numba (extra `fast`), as the
+  compiled engine calls it.
+
+Each variant is the same code object with other globals: the ops of this module
+and every kernel it calls are swapped for their counterparts, so no formula is
+written twice. `@per_ray` marks code that only makes sense for one ray (a BVH
+walk, the integrator loop): it has python and compiled variants but no numpy one.
+
+Bit for bit: the scalar variants do the numpy variant's floating-point operations in
+the same order, and IEEE arithmetic and sqrt are exact, so they agree to the last
+bit, with one documented exception. numpy may take x ** y, arccos, arcsin, arctan2
+and cbrt from its own SIMD library (Intel SVML, on AVX-512 CPUs) where both scalar
+variants call the C library: those five can differ by 1 ulp (unit in the last place)
+between the numpy and the scalar variants. cos, floor, sqrt and the rest agree.
+
+Compiled-variant options (measured on the bench scenes; docs/architecture.md):
+error_model="numpy" (x / 0 is inf or nan, as in numpy, instead of raising), no
+reference counting (`_nrt=False`: kernels only read arrays the caller owns; counting
+references to each array argument on every call made renders 2.3x slower), and
+`inline=True` (numba inlines the function into its callers) for the ops and for the
+functions that take the engine's tuples of arrays (the scene's geometry, the
+materials): passing a tuple of arrays costs several machine words per array and call.
+Math kernels are left to LLVM, which inlines the small ones itself; inlining them in
+numba too only doubled the first compile (80 s instead of 36 s) for no speed.
+"""
+
+from __future__ import annotations
+
+import dis
+import functools
+import hashlib
+import importlib.util
+import math
+import os
+import types
+
+import numpy as np
+
+ENABLED = os.environ.get("RTCLI_NUMBA", "1") != "0" and importlib.util.find_spec("numba") is not None
+INF = math.inf
+
+
+# --- the vocabulary, numpy variant (the names kernels import) ---
+def select(mask, a, b):
+    """a where mask holds, else b (a per-ray branch)."""
+    return np.where(mask, a, b)
+
+
+def not_(mask):
+    """Logical not of a mask."""
+    return np.logical_not(mask)
+
+
+def narrow(t_near, t_far, t1, t2):
+    """The interval [t_near, t_far] cut down to the span between t1 and t2 (either order); a NaN
+    t1 or t2 (0 x inf: a ray lying in a slab's plane) leaves it as it is. The slab test's step."""
+    return np.fmax(t_near, np.minimum(t1, t2)), np.fmin(t_far, np.maximum(t1, t2))
+
+
+def to_int(x):
+    """Truncation toward zero to int64 (x finite)."""
+    return np.asarray(x).astype(np.int64)
+
+
+def bits(x):
+    """The 64 bits of a float as an unsigned integer (for hashing)."""
+    return np.ascontiguousarray(x, dtype=np.float64).view(np.uint64)
+
+
+def u64(k):
+    """An integer as uint64 (for hashing)."""
+    return np.asarray(k).astype(np.uint64)
+
+
+sqrt, floor, cbrt, cos = np.sqrt, np.floor, np.cbrt, np.cos
+arccos, arcsin, arctan2 = np.arccos, np.arcsin, np.arctan2
+minimum, maximum = np.minimum, np.maximum     # NaN in, NaN out
+fmin, fmax = np.fmin, np.fmax                 # a NaN operand is ignored
+copysign, isfinite, isnan = np.copysign, np.isfinite, np.isnan
+
+VOCABULARY = ("select", "not_", "narrow", "to_int", "bits", "u64", "sqrt", "floor", "cbrt", "cos", "arccos", "arcsin",
+              "arctan2", "minimum", "maximum", "fmin", "fmax", "copysign", "isfinite", "isnan")
+
+
+# --- the scalar variant of each op (plain Python; numba compiles the same functions) ---
+def _select(mask, a, b):
+    return a if mask else b
+
+
+def _not(mask):
+    return not mask
+
+
+def _narrow(t_near, t_far, t1, t2):
+    if t1 != t1 or t2 != t2:
+        return t_near, t_far
+    if t1 > t2:
+        t1, t2 = t2, t1
+    return (t1 if t1 > t_near else t_near), (t2 if t2 < t_far else t_far)
+
+
+def _to_int(x):
+    return int(x)
+
+
+def _minimum(a, b):
+    if a != a:
+        return a
+    if b != b:
+        return b
+    return a if a <= b else b
+
+
+def _maximum(a, b):
+    if a != a:
+        return a
+    if b != b:
+        return b
+    return a if a >= b else b
+
+
+def _fmin(a, b):
+    if b != b:
+        return a
+    if a != a:
+        return b
+    return a if a <= b else b
+
+
+def _fmax(a, b):
+    if b != b:
+        return a
+    if a != a:
+        return b
+    return a if a >= b else b
+
+
+def _u64(k):
+    return np.uint64(k)
+
+
+def _bits(x):
+    return np.float64(x).view(np.uint64)
+
+
+def _libm(f):
+    """A C-library function on numpy float64 scalars, nan outside its domain (as in numba)."""
+    def call(*args):
+        try:
+            return np.float64(f(*args))
+        except ValueError:
+            return np.float64(math.nan)
+    call.__name__ = f.__name__
+    return call
+
+
+_SCALAR = dict(select=_select, not_=_not, narrow=_narrow, to_int=_to_int, bits=_bits, u64=_u64, floor=np.floor,
+               minimum=_minimum, maximum=_maximum, fmin=_fmin, fmax=_fmax, isfinite=math.isfinite,
+               isnan=math.isnan, **{name: _libm(f) for name, f in
+                                    dict(sqrt=math.sqrt, cos=math.cos, arccos=math.acos, arcsin=math.asin,
+                                         arctan2=math.atan2, copysign=math.copysign,
+                                         cbrt=getattr(math, "cbrt", lambda x: math.copysign(abs(x) ** (1 / 3), x))
+                                         ).items()})
+
+
+_LIBM = ("sqrt", "cos", "arccos", "arcsin", "arctan2", "copysign", "cbrt")
+
+
+def _numba_ops() -> dict:
+    """The scalar ops as numba sees them: the same functions compiled, libm for the math."""
+    from numba import njit
+    from numba import types as nt
+    from numba.extending import intrinsic
+
+    @intrinsic
+    def float_bits(typingctx, x):
+        def codegen(context, builder, signature, args):
+            from llvmlite import ir
+            return builder.bitcast(args[0], ir.IntType(64))
+        return nt.uint64(nt.float64), codegen
+
+    def cube_root(x):
+        return np.cbrt(x)
+
+    small = njit(inline="always", error_model="numpy", _nrt=False)
+    ops = {name: small(f) for name, f in _SCALAR.items() if f.__module__ == __name__ and name not in _LIBM}
+    ops.update(sqrt=math.sqrt, floor=np.floor, cos=math.cos, arccos=math.acos, arcsin=math.asin,
+               arctan2=math.atan2, copysign=math.copysign, isfinite=math.isfinite, isnan=math.isnan,
+               bits=float_bits, cbrt=small(cube_root))
+    return ops
+
+
+# --- kernels and their variants ---
+class Kernel:
+    """How a kernel is compiled: inline into its callers, or an entry that allocates."""
+
+    def __init__(self, per_ray: bool, inline: bool, entry: bool):
+        self.per_ray, self.inline, self.entry = per_ray, inline, entry
+
+
+def _mark(f, per_ray: bool, inline: bool = False, entry: bool = False):
+    f.__kernel__ = Kernel(per_ray, inline, entry)
+    return f
+
+
+def kernel(f=None, *, inline: bool = False):
+    """Mark a function written in the vocabulary: numpy, python and compiled variants."""
+    if f is None:
+        return lambda g: _mark(g, False, inline)
+    return _mark(f, False, inline)
+
+
+def per_ray(f=None, *, inline: bool = False, entry: bool = False):
+    """Mark scalar-only code (loops over a BVH, the integrator): python and compiled variants.
+    `entry`: called from Python with arrays it may allocate (numba's reference counting on)."""
+    if f is None:
+        return lambda g: _mark(g, True, inline, entry)
+    return _mark(f, True, inline, entry)
+
+
+def is_kernel(f) -> bool:
+    return hasattr(f, "__kernel__")
+
+
+_made: dict = {}
+_ops: dict = {}
+
+
+def python(f, **bind):
+    """The plain-Python scalar variant of kernel f (its globals `bind` replaced, if given).
+
+    It computes in numpy float64 scalars, so x / 0 is inf as in the other variants (warnings
+    off), and calls the C library for the math, as numba does."""
+    made = _variant(f, "python", bind)
+
+    @functools.wraps(made)
+    def call(*args):
+        with np.errstate(all="ignore"):
+            return made(*(np.float64(a) if type(a) is float else a for a in args))
+    return call
+
+
+def compiled(f, **bind):
+    """The numba-compiled scalar variant of kernel f. `bind` replaces globals of f: one
+    source, specialised (say, a BVH walk for triangles or for scene objects)."""
+    return _variant(f, "compiled", bind)
+
+
+def _variant(f, variant: str, bind: dict):
+    if not is_kernel(f):
+        raise TypeError(f"{f.__qualname__} is not a kernel")
+    key = (f, variant, tuple(sorted((k, id(v)) for k, v in bind.items())))
+    if key in _made:
+        return _made[key]
+    if variant not in _ops:
+        _ops[variant] = _numba_ops() if variant == "compiled" else dict(_SCALAR)
+    scope = dict(f.__globals__)
+    scope.update(_ops[variant])
+    made = types.FunctionType(f.__code__, scope, f.__name__, f.__defaults__, f.__closure__)
+    made.__qualname__ = f.__qualname__ + _suffix(bind)
+    made.__module__, made.__doc__ = f.__module__, f.__doc__
+    if variant == "compiled":
+        made = _numba(made, f.__kernel__)
+    _made[key] = made                    # before the callees: a kernel may call itself through bind
+    for name in f.__code__.co_names:
+        value = bind[name] if name in bind else f.__globals__.get(name)
+        if name in bind and not is_kernel(value):
+            scope[name] = value
+        elif is_kernel(value):
+            scope[name] = _variant(value, variant, {})
+        elif isinstance(value, types.ModuleType) and value not in (np, math):
+            raise TypeError(f"kernel {f.__qualname__} calls through module {value.__name__}: "
+                            "import the kernels it calls by name")
+    return made
+
+
+def _suffix(bind: dict) -> str:
+    """A short name for what is bound, the same in every run (numba names its cache files by it)."""
+    if not bind:
+        return ""
+    name = lambda v: getattr(getattr(v, "py_func", v), "__qualname__", None) or repr(v)
+    what = ",".join(f"{k}={name(v)}" for k, v in sorted(bind.items()))
+    return "_" + hashlib.sha1(what.encode()).hexdigest()[:12]
+
+
+def _numba(f, how: Kernel):
+    from numba import njit
+    options = dict(cache=True, error_model="numpy")
+    if not how.entry:
+        options["_nrt"] = False
+    if how.inline:
+        options["inline"] = "always"
+    return njit(**options)(f)
+
+
+INEXACT = ("arccos", "arcsin", "arctan2", "cbrt")        # numpy may take these (and x ** y) from SVML
+
+
+def inexact(f, seen=None) -> set:
+    """The functions f (or a kernel it calls) uses whose numpy variant may differ from the C
+    library's by an ulp: some of INEXACT, and "**" for x ** y."""
+    seen = set() if seen is None else seen
+    if f in seen:
+        return set()
+    seen.add(f)
+    found = {"**"} if any(i.opname == "BINARY_POWER" or (i.opname == "BINARY_OP" and i.argrepr == "**")
+                          for i in dis.get_instructions(f)) else set()
+    for name in f.__code__.co_names:
+        value = f.__globals__.get(name)
+        if name in INEXACT and value is globals()[name]:
+            found.add(name)
+        elif is_kernel(value):
+            found |= inexact(value, seen)
+    return found
+
+
+def variants_made() -> list:
+    """(qualname, variant) of every variant made so far (for tests and the cache guard)."""
+    return [(f.__qualname__, v) for (f, v, _) in _made]
