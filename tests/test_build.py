@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import scene_from_yaml
+from helpers import scene_from_yaml
 
 from rtcli.core import camera as cameras
 from rtcli.errors import SceneError

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import scene_from_yaml
 
 from rtcli.core import camera as cameras
 from rtcli.errors import SceneError
 from rtcli.render import camera_rays
-from tests.conftest import scene_from_yaml
 
 EYE, LOOK, UP = np.array([1.0, 2.0, 3.0]), np.array([-2.0, 0.5, -1.0]), np.array([0.2, 1.0, 0.1])
 

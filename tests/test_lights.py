@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from tests.conftest import one_pixel
+from helpers import one_pixel
 
 FLOOR = """
 image: {{width: 1, height: 1}}

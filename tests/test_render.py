@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import scene_from_yaml
 
 from rtcli.render import Job, render, sample_positions
-from tests.conftest import scene_from_yaml
 
 W, H = 23, 17                       # not multiples of the block or tile sizes
 

@@ -12,10 +12,10 @@ written from those angles, not from the renderer's vectors.
 from __future__ import annotations
 
 import numpy as np
+from helpers import one_pixel, scene_from_yaml
 
 from rtcli.render import camera_rays
 from rtcli.wavefront.intersect import find_first_hit
-from tests.conftest import one_pixel, scene_from_yaml
 
 RTOL = 1e-9
 COS30, COS60, COS15 = np.cos(np.radians(30)), 0.5, np.cos(np.radians(15))

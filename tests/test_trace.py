@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import one_pixel, scene_from_yaml
 
 from rtcli.core import vec as vectors
 from rtcli.wavefront.intersect import find_first_hit, surface
 from rtcli.wavefront.rays import Rays
-from tests.conftest import one_pixel, scene_from_yaml
 
 RTOL = 1e-9
 E1, E2 = np.array([0.2, 0.4, 0.6]), np.array([0.9, 0.1, 0.3])

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import scene_from_yaml
 
 from rtcli.core import transform as tf
 from rtcli.core.vec import cross3, dot3, reflect, split, stack, unit3
 from rtcli.errors import SceneError
-from tests.conftest import scene_from_yaml
 
 RNG = np.random.default_rng(42)
 

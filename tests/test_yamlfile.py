@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import pytest
 import yaml
-from conftest import scene_from_yaml
+from helpers import scene_from_yaml
 
 from rtcli.errors import SceneError
 from rtcli.scenefile import yamlfile

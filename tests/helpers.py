@@ -1,0 +1,31 @@
+"""Plain helpers for the tests (conftest.py holds the fixtures): scenes from YAML text, one-pixel renders.
+
+Tests import them as `from helpers import ...` (pytest puts tests/ on the path).
+"""
+
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+
+from rtcli.render import Job, render_tile
+from rtcli.scenefile import yamlfile
+from rtcli.scenefile.build import scene_from_docs
+
+
+def scene_from_yaml(text: str, tmp_path=None, name: str = "scene.yaml"):
+    """Build a Scene from YAML text; written to tmp_path when given (for includes and files)."""
+    text = textwrap.dedent(text)
+    if tmp_path is not None:
+        path = tmp_path / name
+        path.write_text(text)
+        return scene_from_docs(yamlfile.load(str(path)))
+    return scene_from_docs([yamlfile.parse(text, name)])
+
+
+def one_pixel(scene, i: int = 0, j: int = 0, width=None, height=None) -> np.ndarray:
+    """The float color of pixel (i, j), unclamped."""
+    job = Job(width or scene.settings.width, height or scene.settings.height)
+    color, _ = render_tile(scene, job, np.array([i]), np.array([j]))
+    return color[0]
