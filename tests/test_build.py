@@ -12,6 +12,7 @@ from helpers import scene_from_yaml
 
 from rtcli.core import camera as cameras
 from rtcli.errors import SceneError
+from rtcli.shapes import SHAPES
 
 CAM = "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
 
@@ -193,8 +194,7 @@ REFERENCES = {
     "two_shapes": (obj("sphere: {}\n    box: {}"),
                    "scene.yaml:4:5: objects[0].box: an object has one shape, but 'sphere' is already given"),
     "no_shape": (obj("name: x"),
-                 "scene.yaml:3:5: objects[0]: missing shape: one of sphere, plane, triangle, polygon, "
-                 "square, box, cylinder, cone, torus, mesh, csg, group"),
+                 "scene.yaml:3:5: objects[0]: missing shape: one of " + ", ".join([*SHAPES, "csg", "group"])),
 }
 
 
