@@ -11,12 +11,13 @@ import numpy as np
 
 from rtcli.core.vec import cross3, dot3, unit3
 from rtcli.shapes.base import POOL_WIDTH, Param, ParamError, Shape, ShapeKernels
-from rtcli.shapes.plane import in_plane_axes, planar_uv, plane_t
+from rtcli.shapes.plane import NORMAL, POINT, in_plane_axes, normals, plane_t, uv
 from rtcli.variants import INF, kernel, select, to_int
 
-# the row: first vertex, unit normal, the two axes of the projection, vertex count, first pool
-# row, in-plane (u, v) axes e1, e2; the vertices are pool rows (x, y, z)
-POINT, NORMAL, AXIS_I, AXIS_J, COUNT, FIRST, E1, E2 = 0, 3, 6, 7, 8, 9, 10, 13
+# the row: a plane's (its first vertex, unit normal, in-plane (u, v) axes e1, e2: the plane's normals
+# and uv kernels serve), then the two axes of the projection, the vertex count and the first pool
+# row; the vertices are pool rows (x, y, z)
+AXIS_I, AXIS_J, COUNT, FIRST = 12, 13, 14, 15
 
 
 @kernel
@@ -47,16 +48,6 @@ def hit(s, pool, ox, oy, oz, dx, dy, dz, t_min, t_max):
     return select(inside, t, INF), 0
 
 
-@kernel
-def normals(s, pool, prim, x, y, z):
-    return s[NORMAL], s[NORMAL + 1], s[NORMAL + 2], s[NORMAL], s[NORMAL + 1], s[NORMAL + 2]
-
-
-@kernel
-def uv(s, pool, prim, x, y, z):
-    return planar_uv(s, POINT, E1, x, y, z)
-
-
 class Polygon(Shape):
     params = (Param("vertices", "vectors", min_count=3),)
     kernels = ShapeKernels(hit, normals, uv)
@@ -73,7 +64,7 @@ class Polygon(Shape):
             raise ParamError("vertices", "polygon vertices are not coplanar")
         self.axes = [k for k in range(3) if k != int(np.argmax(np.abs(self.n)))]
         self.e1, self.e2 = in_plane_axes(self.n)
-        self.row = np.array([*self.v[0], *self.n, *self.axes, len(self.v), 0.0, *self.e1, *self.e2])
+        self.row = np.array([*self.v[0], *self.n, *self.e1, *self.e2, *self.axes, len(self.v), 0.0])
         self.pool = np.zeros((len(self.v), POOL_WIDTH))
         self.pool[:, :3] = self.v
 
