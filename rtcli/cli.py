@@ -99,7 +99,7 @@ def _progress(enabled: bool, label: str):
 @click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")
 @click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
               help="numpy core, or compiled integrator (numba); auto: compiled for big jobs it can render.")
-@click.option("--no-bvh", is_flag=True, help="numpy engine: test every object against every ray (for comparisons).")
+@click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects: test each against every ray (for comparisons).")
 def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
            gamma, quiet, progress, stats, engine, no_bvh):
     """Render SCENE.yaml to a PNG."""
@@ -112,8 +112,6 @@ def render(scene_file, output, width, height, block_size, samples, max_depth, wo
         scene.settings.samples = samples
     if max_depth:
         scene.settings.max_depth = max_depth
-    if no_bvh and engine == "auto":
-        engine = "numpy"                   # brute force is a numpy-engine comparison
     job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine, bvh=not no_bvh)
     show = _progress(not quiet and (progress or sys.stderr.isatty()), os.path.basename(scene_file))
     image, counts = render_image(scene, job, workers or os.cpu_count() or 1, show)

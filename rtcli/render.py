@@ -42,7 +42,7 @@ class Job:
     signature: bool = False          # trace primary rays only and return object ids
     gamma: bool = False              # sRGB-encode when converting to 8 bits
     engine: str = "auto"             # auto, numpy or compiled (see rtcli.compiled.choose)
-    bvh: bool = True                 # numpy engine: a BVH over scenes of many objects
+    bvh: bool = True                 # a BVH over the scene's objects when there are enough (Scene.wants_bvh)
 
 
 def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -134,7 +134,7 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     image = np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
     stats, tiles = Stats(), list(_tiles(job, 1 if job.signature else scene.settings.samples))
     traced = sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
-    engine = None if job.signature else compiled.choose(scene, job.engine, traced)
+    engine = None if job.signature else compiled.choose(scene, job.engine, traced, job.bvh)
     if not engine:
         wavefront.prepare(scene, job.bvh)
     stats.engine = "compiled" if engine else "numpy"            # add() keeps it

@@ -15,7 +15,6 @@ from rtcli import variants
 from rtcli.errors import RtcliError
 from rtcli.render import Job, render, render_tile
 from rtcli.scenefile.build import load_scene
-from rtcli.wavefront.accel import Accelerator
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 
@@ -25,7 +24,7 @@ SUPPORTED = [p for p in SCENES if fast.unsupported(load_scene(str(p))) is None]
 
 
 def both(scene, width=96, height=72, **job):
-    """(numpy image, compiled image, numpy stats, compiled stats) of one scene."""
+    """(numpy image, compiled image, numpy stats, compiled stats) of one scene (job: Job's options)."""
     a, sa = render(scene, Job(width, height, engine="numpy", **job))
     b, sb = render(scene, Job(width, height, engine="compiled", **job))
     return a, b, sa, sb
@@ -144,17 +143,16 @@ objects:
 
 
 @pytest.mark.parametrize("spec", ["phong", "blinn"])
-@pytest.mark.parametrize("accel", [False, True])
-def test_transformed_shapes_glass_and_every_kind_of_light(yaml_scene, spec, accel):
+@pytest.mark.parametrize("bvh", [False, True])
+def test_transformed_shapes_glass_and_every_kind_of_light(yaml_scene, spec, bvh):
     """Every kind of shape the compiled engine has, most under transforms (a mirror one too),
     a smooth glass triangle and a concave polygon; attenuated, spot and area lights; with and
-    without the numpy core's Accelerator."""
+    without a BVH over the objects (both engines alike)."""
     scene = yaml_scene(TRANSFORMED.replace("SPEC", spec))
-    if accel:
-        scene.accel = Accelerator(scene)
+    assert scene.wants_bvh
     ids, _ = render(scene, Job(120, 90, signature=True))
     assert set(range(1, len(scene.objects) + 1)) <= set(np.unique(ids).tolist())    # each one in view
-    a, b, sa, sb = both(scene, 120, 90)
+    a, b, sa, sb = both(scene, 120, 90, bvh=bvh)
     assert np.array_equal(a, b)
     assert sb.refracted > 0 and sb.reflected > 0 and sb.shadow > 0
     assert len(np.unique(b.reshape(-1, 3), axis=0)) > 1000          # a real picture, not a flat fill
@@ -169,13 +167,6 @@ def test_samples_max_depth_block_size_and_workers(yaml_scene):
     assert np.array_equal(b, c)
 
 
-def with_accelerator(scene):
-    """The scene as load_scene prepares it: an Accelerator once it has 8 bounded objects."""
-    if Accelerator.wanted(scene):
-        scene.accel = Accelerator(scene)
-    return scene
-
-
 def test_many_objects_go_through_the_scene_bvh(yaml_scene):
     rng = np.random.default_rng(5)
     balls = "\n".join(f"  - {{sphere: {{center: [{x:.3f}, {y:.3f}, {z:.3f}], radius: {r:.3f}}}, "
@@ -187,8 +178,7 @@ def test_many_objects_go_through_the_scene_bvh(yaml_scene):
         objects:
         {balls}
         """.replace("\n        ", "\n"))
-    assert fast.Compiled(scene).geometry.links.shape[0] == 1        # no Accelerator: objects in file order
-    with_accelerator(scene)
+    assert fast.Compiled(scene, bvh=False).geometry.links.shape[0] == 1   # no BVH: objects in file order
     assert fast.Compiled(scene).geometry.links.shape[0] > 1
     a, b, _, _ = both(scene, 80, 80)
     assert np.array_equal(a, b)

@@ -42,8 +42,8 @@ class Compiled:
     Making one compiles the integrator, or loads it from numba's cache, at once: worker
     processes forked afterwards inherit the machine code."""
 
-    def __init__(self, scene):
-        self.geometry, stack = geometry(scene)
+    def __init__(self, scene, bvh: bool = True):
+        self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh)
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
         nowhere, none = Camera(*np.zeros((4, 3))), np.zeros(0)
         with _no_blas_lookup():
@@ -126,15 +126,16 @@ def _load() -> str | None:
 AUTO_RAYS = 1_000_000
 
 
-def choose(scene, engine: str, rays: int = AUTO_RAYS) -> Compiled | None:
+def choose(scene, engine: str, rays: int = AUTO_RAYS, bvh: bool = True) -> Compiled | None:
     """The compiled engine for `scene`, or None for the numpy engine; RtcliError when
-    `engine` is "compiled" and it cannot be had. `rays`: how many primary rays the job traces."""
+    `engine` is "compiled" and it cannot be had. `rays`: how many primary rays the job traces;
+    `bvh`: a BVH over the scene's objects when there are enough of them."""
     if engine == "numpy" or (engine == "auto" and rays < AUTO_RAYS):
         return None
     shape = unsupported(scene)
     why = f"it does not handle {shape} (--engine numpy does)" if shape else _load()
     if why is None:
-        return Compiled(scene)
+        return Compiled(scene, bvh)
     if engine == "compiled":
         raise RtcliError(f"--engine compiled cannot render this scene: {why}")
     return None

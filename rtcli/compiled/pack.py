@@ -10,8 +10,9 @@ Geometry (`Geometry`), one row per scene object:
 - `ints` (N, 4), by the names KIND (the shape's place in the registry), TRANSFORMED,
   CASTS (its material casts shadows) and MATERIAL;
 - `listed`: the objects tested one by one: the unbounded ones (planes), or, as the
-  numpy engine does for a scene without its Accelerator (fewer than 8 bounded
-  objects), every object in file order, so that ties go the same way;
+  numpy engine does for a scene without a BVH (Scene.wants_bvh: fewer than 8
+  bounded objects, or --no-bvh), every object in file order, so that ties go the
+  same way;
 - `nodes`, `links`, `perm`: BVH trees one after another (rtcli/core/bvh.py's layout),
   the scene's over the other objects first (root 0), then each mesh's over its faces;
 - `pool`: the rows shapes own (polygon vertices, triangles); a shape's row says where
@@ -77,12 +78,12 @@ class _Trees:
                 np.concatenate(self.perm).astype(np.int64))
 
 
-def geometry(scene) -> tuple[Geometry, int]:
-    """The scene's geometry, and the traversal stack it needs (the scene's tree, then a mesh's)."""
+def geometry(scene, tree: bool) -> tuple[Geometry, int]:
+    """The scene's geometry, and the traversal stack it needs (the scene's tree, then a mesh's).
+    Without `tree` every object is listed, in file order."""
     n = len(scene.objects)
     objects, ints = np.zeros((n, OBJECT_WIDTH)), np.zeros((n, 4), dtype=np.int64)
     boxes = scene.boxes
-    tree = scene.accel is not None                   # else every object is listed, in file order
     listed = [k for k, b in enumerate(boxes) if b is None or not tree]
     members = np.array([k for k, b in enumerate(boxes) if b is not None and tree], dtype=np.int64)
     trees, mesh_depth = _Trees(), 0

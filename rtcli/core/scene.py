@@ -11,6 +11,7 @@ from rtcli.core.bvh import padded
 from rtcli.core.materials import MaterialTable
 from rtcli.core.transform import Transform, outer_bounds
 
+BVH_MIN_OBJECTS = 8        # from this many bounded objects on, a BVH over them pays (both engines)
 
 @dataclass
 class SceneObject:
@@ -57,6 +58,12 @@ class Scene:
     def boxes(self) -> list:
         """Each object's world-space box (lo, hi), padded as the BVH's, or None when unbounded."""
         return [None if b is None else padded(*b) for b in (o.bounds() for o in self.objects)]
+
+    @functools.cached_property
+    def wants_bvh(self) -> bool:
+        """Whether the scene has enough bounded objects for a BVH over them to pay. Both engines
+        decide alike, so that ties between objects go the same way."""
+        return sum(b is not None for b in self.boxes) >= BVH_MIN_OBJECTS
 
     @functools.cached_property
     def size(self) -> float:

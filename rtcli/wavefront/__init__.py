@@ -17,10 +17,10 @@ def prepare(scene, bvh: bool = True) -> None:
     """Ready a scene for the numpy engine: a BVH over its objects when there are enough of them
     (unless `bvh` is False), and the compiled walks it will use loaded now, so that worker
     processes forked later inherit them."""
-    if bvh and scene.accel is None and Accelerator.wanted(scene):
-        scene.accel = Accelerator(scene)
-    if not bvh:
+    if not (bvh and scene.wants_bvh):
         scene.accel = None
+    elif scene.accel is None:
+        scene.accel = Accelerator(scene)
     if variants.ENABLED and uses_compiled_walks(scene):
         _warm_up(scene)
 

@@ -28,8 +28,6 @@ from rtcli.wavefront.intersect import (
     object_hit,
 )
 
-MIN_OBJECTS = 8            # below this many bounded objects the plain loop is faster
-
 
 class Accelerator:
     """The scene's unbounded objects, and a BVH over its bounded ones."""
@@ -47,11 +45,6 @@ class Accelerator:
         self.shadow = scene.materials.shadow[self.material]
         self.all_spheres = bool(self.is_sphere[self.members].all())    # the compiled walk can do it all
         self._geometry = None
-
-    @staticmethod
-    def wanted(scene) -> bool:
-        """Whether the scene has enough bounded objects for the BVH to pay."""
-        return sum(b is not None for b in scene.boxes) >= MIN_OBJECTS
 
     def batched(self, obj: np.ndarray) -> np.ndarray:
         """Which hits (object indices, -1 none) are on untransformed spheres."""
@@ -95,7 +88,7 @@ class Accelerator:
         from rtcli.compiled import query
         from rtcli.compiled.pack import geometry
         if self._geometry is None:
-            self._geometry = geometry(scene)
+            self._geometry = geometry(scene, tree=True)
         geo, depth = self._geometry
         n = o.shape[1]
         t, obj, prim = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
