@@ -19,6 +19,7 @@ from rtcli.core.textures import Checker, ImageTexture
 from rtcli.errors import SceneError
 from rtcli.scenefile.params import Params, as_params, describe
 from rtcli.scenefile.presets import PRESETS
+from rtcli.scenefile.yamlfile import MapNode
 from rtcli.shapes import SHAPES
 
 OBJECT_KINDS = tuple(SHAPES) + ("csg", "group")
@@ -216,10 +217,7 @@ class ObjectBuilder:
     def _shape_params(p: Params, kind: str) -> Params:
         if p.node[kind] is None:
             p.read.add(kind)
-            empty = type(p.node)()
-            empty.where, empty.key_where, empty.value_where = p.node.value_where[kind], {}, {}
-            empty.folder = p.folder
-            return Params(empty, p.key_path(kind))
+            return Params(MapNode.empty(p.node.value_where[kind], p.folder), p.key_path(kind))
         return p.sub(kind)
 
 
