@@ -207,12 +207,13 @@ def read_png(path) -> np.ndarray:
 def flip_map(actual: np.ndarray, expected: np.ndarray) -> tuple[np.ndarray, float]:
     """NVIDIA FLIP's perceptual error map (magma colors, uint8) and its mean, for two RGB images.
 
-    Needs the optional flip-evaluator package (`pip install 'rtcli[flip]'`).
+    Needs the optional flip-evaluator package (`pip install -e '.[flip]'` in the rtcli folder).
     """
     try:
         import flip_evaluator
     except ImportError:
-        raise RtcliError("--flip needs the flip-evaluator package: pip install 'rtcli[flip]'") from None
+        raise RtcliError("--flip needs the flip-evaluator package: pip install -e '.[flip]' in the rtcli "
+                         "folder (rtcli is not on the package index)") from None
     if actual.ndim != 3 or actual.shape != expected.shape:
         raise RtcliError("--flip compares two RGB images of the same size")
     error, mean, _ = flip_evaluator.evaluate(expected.astype(np.float32) / 255,

@@ -13,8 +13,11 @@ import contextlib
 import contextvars
 import os
 import stat
+import warnings
 
-from rtcli.scenefile.limits import MB
+from PIL import Image
+
+from rtcli.scenefile.limits import MAX_IMAGE_BYTES, MAX_TEXTURE_PIXELS, MB
 
 _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
           (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
@@ -85,3 +88,20 @@ def recording_inputs():
         yield read
     finally:
         _read.reset(token)
+
+
+@contextlib.contextmanager
+def open_image(path: str):
+    """A texture opened by Pillow after the checks above; a decompression bomb (more than
+    MAX_TEXTURE_PIXELS texels, however small the file) is an InputError, not a warning."""
+    check_input(path, MAX_IMAGE_BYTES)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(path) as img:
+                w, h = img.size
+                if w * h > MAX_TEXTURE_PIXELS:
+                    raise InputError(f"{w}x{h} is {w * h:,} texels, more than the {MAX_TEXTURE_PIXELS:,} allowed")
+                yield img
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as e:
+        raise InputError(f"refused as a decompression bomb: {' '.join(str(e).split())}") from None

@@ -130,7 +130,7 @@ class Params:
         if not isinstance(x, int) or isinstance(x, bool):
             raise self.error(key, f"must be an integer, got {describe(x)}")
         if (lo is not None and x < lo) or (hi is not None and x > hi):
-            raise self.error(key, f"must be in {lo}..{hi}, got {x}")
+            raise self.error(key, f"must be in {lo}..{hi}, got {describe(x)}")
         return x
 
     def boolean(self, key, default=REQUIRED) -> bool:
