@@ -17,18 +17,10 @@ import time
 import click
 
 from rtcli import __version__
-from rtcli.errors import RtcliError, one_line, shown
+from rtcli.errors import Interrupted, RtcliError, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
 INSTALL = "pip install -e '.[{extra}]' in the rtcli folder (rtcli is not on the package index)"
-
-
-class Interrupted(BaseException):
-    """SIGINT or SIGTERM arrived: unwind (workers stopped, temporary files removed), then exit 128 + signum."""
-
-    def __init__(self, signum: int):
-        super().__init__(signum)
-        self.signum = signum
 
 
 def _on_signal(signum, frame):

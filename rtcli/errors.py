@@ -40,6 +40,14 @@ def one_line(message: str) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
 
 
+class Interrupted(BaseException):
+    """SIGINT or SIGTERM arrived: unwind (workers stopped, temporary files removed); exit 128 + signum."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
 class RtcliError(Exception):
     """Any error meant for the user: bad input, unreadable file, bad option."""
 

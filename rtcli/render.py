@@ -11,9 +11,11 @@ numpy core or the compiled integrator (rtcli/fast/) to trace the primary rays.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +24,7 @@ from rtcli import compiled as fast
 from rtcli import kernels
 from rtcli.core.jitter import uniform
 from rtcli.core.scene import Scene
+from rtcli.pool import stop_pool, watch_worker, worker_died
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.trace import trace
@@ -108,6 +111,7 @@ _worker_scene = (None, None)               # the scene and its compiled form, se
 def _init_worker(scene: Scene, compiled) -> None:
     global _worker_scene
     _worker_scene = (scene, compiled)
+    watch_worker()
 
 
 def _worker_tile(job: Job, rows, cols):
@@ -127,12 +131,13 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     traced = sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
     compiled = None if job.signature else fast.choose(scene, job.engine, traced)
     stats.engine = "compiled" if compiled else "numpy"          # add() keeps it
-    for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, compiled, job, tiles, workers), 1):
-        block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
-        image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
-        stats.add(s)
-        if progress:
-            progress(done, len(tiles))
+    with contextlib.closing(_map_tiles(scene, compiled, job, tiles, workers)) as results:   # stops the pool
+        for done, (rows, cols, values, s) in enumerate(results, 1):
+            block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
+            image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
+            stats.add(s)
+            if progress:
+                progress(done, len(tiles))
     return image, stats
 
 
@@ -151,8 +156,14 @@ def _map_tiles(scene: Scene, compiled, job: Job, tiles: list, workers: int):
     if not compiled and _uses_kernels(scene):
         kernels.warm_up()                  # loaded once here, not once per worker (Compiled loads itself)
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
-    with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
-                             initargs=(scene, compiled)) as pool:
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(scene, compiled))
+    finished = False
+    try:
         futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
         for f in as_completed(futures):
             yield f.result()
+        finished = True
+    except BrokenProcessPool:
+        raise worker_died(pool) from None
+    finally:
+        stop_pool(pool, finished)
