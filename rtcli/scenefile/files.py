@@ -65,9 +65,11 @@ def check_input(path: str, limit: int) -> int:
 
 def read_bytes(path: str, limit: int) -> bytes:
     """The whole content of a checked regular file, never more than `limit` bytes."""
-    check_input(path, limit)
+    size = check_input(path, limit)
     with open(path, "rb") as f:
-        data = f.read(limit + 1)
+        data = f.read(size + 1)                   # read(n) reserves n bytes: ask for what stat said
+        if len(data) > size:
+            data += f.read(limit + 1 - len(data))
     if len(data) > limit:
         raise InputError(f"too large: it grew past the {limit // MB} MB allowed while being read")
     return data
