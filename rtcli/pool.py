@@ -11,6 +11,7 @@ worker outlives a parent that was killed outright.
 from __future__ import annotations
 
 import signal
+import time
 
 from rtcli.errors import Interrupted, RtcliError
 
@@ -45,10 +46,25 @@ def stop_pool(pool, finished: bool) -> None:
         p.join(timeout=5)
 
 
+def _exit_codes(workers: list, wait: float = 1.0) -> list[int]:
+    """The non-zero exit codes of the workers, waiting a moment for the one that died to be reaped.
+
+    The pool can learn of a death (a half-written result) a moment before the
+    kernel reports the dead process's status; the codes other than SIGTERM's are
+    the informative ones (the pool terminates the survivors with SIGTERM).
+    """
+    deadline = time.monotonic() + wait
+    while True:
+        codes = [p.exitcode for p in workers if p.exitcode not in (None, 0)]
+        if any(c != -signal.SIGTERM for c in codes) or time.monotonic() > deadline:
+            return codes
+        time.sleep(0.01)
+
+
 def worker_died(pool) -> BaseException:
     """What to raise when a worker died mid-render: Interrupted when SIGTERM or SIGINT killed it
     (the whole process group was signalled), else an RtcliError naming the signal or exit code."""
-    codes = [p.exitcode for p in _processes(pool) if p.exitcode not in (None, 0)]
+    codes = _exit_codes(_processes(pool))
     signals = [-c for c in codes if c < 0]
     if signals and all(s in (signal.SIGTERM, signal.SIGINT) for s in signals):
         return Interrupted(signals[0])

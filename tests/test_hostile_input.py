@@ -281,3 +281,10 @@ def test_yaml_side_of_a_sphere_is_small(tmp_path):
         tracemalloc.stop()
     assert len(docs[0]["objects"]) == 20000
     assert kept / 20000 < 1500 and peak / 20000 < 2000
+
+
+def test_eye_whose_image_plane_rounds_away_is_refused(tmp_path):
+    """At 1e17 from the origin a plane one unit from the eye is lost in rounding: rays would have no direction."""
+    message = load_error(tmp_path, "camera: {eye: [0, 0, 1e17], look_at: [0, 0, 0]}\nobjects: []\n")
+    assert message.startswith("scene.yaml:1:9: camera: the eye is too far from the origin for the size of its "
+                              "image plane")

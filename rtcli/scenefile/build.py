@@ -121,6 +121,7 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
     else:
         p.read.add("render")
     camera, eye = camera_from(p.sub("camera"))
+    check_resolvable(p, camera, settings.width, settings.height)
     return Scene(camera=camera, objects=builder.objects, materials=MaterialTable(table),
                  lights=lights, background=p.color("background", (0.0, 0.0, 0.0)),
                  ambient=p.color("ambient", (0.1, 0.1, 0.1)), settings=settings, eye=eye)
@@ -158,6 +159,23 @@ def camera_from(c: Params):
         raise c.error("fov", f"must be between 0 and 180 degrees, got {fov:g}")
     c.check_unused()
     return functools.partial(cameras.from_fov, eye, look_at, up, fov), eye
+
+
+def check_resolvable(p: Params, camera, width: int, height: int) -> None:
+    """Refuse a camera whose pixels are finer than the rounding of its image-plane points.
+
+    Rays go from the eye to points of the image plane, p - eye. With the eye very
+    far from the origin compared with a pixel of the plane (an eye at 1e17 and a
+    plane one unit away), those points round to a grid coarser than the pixels:
+    neighbouring pixels would get the same ray, or rays no direction at all.
+    """
+    cam = camera(width, height)
+    rounding = np.spacing(max(np.abs(cam.eye).max(), np.abs(cam.origin).max()))
+    pixel = min(np.linalg.norm(cam.right) / width, np.linalg.norm(cam.down) / height)
+    if not 4 * rounding < pixel:
+        raise p.error("camera", "the eye is too far from the origin for the size of its image plane: "
+                                "neighbouring pixels would get the same ray in double precision (bring the "
+                                "scene nearer the origin, or make the window or fov larger)")
 
 
 def light_from(p: Params) -> PointLight:
