@@ -168,7 +168,7 @@ def _progress(enabled: bool, label: str):
 @click.option("--no-bvh", is_flag=True, help="numpy engine: test every object against every ray (for comparisons).")
 def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
            gamma, quiet, progress, stats, engine, no_bvh):
-    """Render SCENE.yaml to a PNG (see docs/scene-format.md for the scene format)."""
+    """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format)."""
     from rtcli.render import render as render_image
     from rtcli.writer import write_png
     start = time.perf_counter()
@@ -183,7 +183,7 @@ def render(scene_file, output, width, height, block_size, samples, max_depth, wo
     if no_bvh and engine == "auto":
         engine = "numpy"                   # brute force is a numpy-engine comparison
     job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine)
-    show = _progress(not quiet and (progress or sys.stderr.isatty()), os.path.basename(scene_file))
+    show = _progress(not quiet and (progress or sys.stderr.isatty()), one_line(os.path.basename(scene_file)))
     image, counts = render_image(scene, job, workers or os.cpu_count() or 1, show)
     write_png(out, image)
     if stats:
@@ -225,7 +225,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
         click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
         click.echo(f"{0:>5}  {'(background)':<24} {'-':<10} {counts[0]:>9}")
         for o in scene.objects:
-            click.echo(f"{o.id:>5}  {o.name or '-':<24} {o.kind:<10} {counts[o.id]:>9}")
+            click.echo(f"{o.id:>5}  {one_line(o.name) or '-':<24} {o.kind:<10} {counts[o.id]:>9}")
 
 
 @main.command()

@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 
 import numpy as np
-from PIL import Image, UnidentifiedImageError
+from PIL import UnidentifiedImageError
 
 from rtcli.core import transform as tf
 from rtcli.core.materials import Material
