@@ -2,73 +2,137 @@
 
 Argument handling only. Errors from the library (RtcliError) and usage errors
 become one `error: ...` line on stderr with exit code 2; `--debug` shows the
-traceback instead.
+traceback instead. Ctrl-C (SIGINT) and SIGTERM stop any command at once with
+`error: interrupted` and exit code 130 or 143, leaving no file behind.
 """
 
 from __future__ import annotations
 
 import os
+import signal
 import sys
+import threading
 import time
 
 import click
 
 from rtcli import __version__
-from rtcli.errors import RtcliError
+from rtcli.errors import Interrupted, RtcliError, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
+INSTALL = "pip install -e '.[{extra}]' in the rtcli folder (rtcli is not on the package index)"
+
+
+def _on_signal(signum, frame):
+    raise Interrupted(signum)
 
 
 class RtcliGroup(click.Group):
-    """A click group whose errors are one line: 'error: ...', exit 2."""
+    """A click group whose errors are one line: 'error: ...', exit 2; no arguments shows the help."""
 
     def main(self, args=None, prog_name=None, **extra):
         args = list(sys.argv[1:] if args is None else args)
         extra.pop("standalone_mode", None)
+        if not args:
+            args = ["--help"]
+        restore = _catch_signals()
         try:
             code = super().main(args, prog_name or "rtcli", standalone_mode=False, **extra)
         except click.exceptions.Exit as e:
             sys.exit(e.exit_code)
-        except click.exceptions.Abort:
+        except (Interrupted, click.exceptions.Abort) as e:
+            if sys.stderr.isatty():
+                click.echo(err=True)                   # end the line the terminal's ^C is on
             click.echo("error: interrupted", err=True)
-            sys.exit(130)
+            sys.exit(128 + getattr(e, "signum", signal.SIGINT))
         except click.ClickException as e:
-            click.echo(f"error: {e.format_message()}", err=True)
+            click.echo(f"error: {one_line(e.format_message())}", err=True)
             sys.exit(2)
-        except RtcliError as e:
+        except (RtcliError, MemoryError) as e:
             if "--debug" in args:
                 raise
-            click.echo(f"error: {e}", err=True)
+            click.echo(f"error: {one_line(str(e) or 'out of memory')}", err=True)
             sys.exit(2)
+        finally:
+            restore()
         sys.exit(code if isinstance(code, int) else 0)
 
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            raise Interrupted(signal.SIGINT) from None
 
-@click.group(cls=RtcliGroup, context_settings={"help_option_names": ["-h", "--help"]})
+
+def _catch_signals():
+    """Turn SIGTERM into Interrupted (SIGINT is KeyboardInterrupt already); returns the undo."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    previous = signal.signal(signal.SIGTERM, _on_signal)
+    return lambda: signal.signal(signal.SIGTERM, previous)
+
+
+@click.group(cls=RtcliGroup, context_settings={"help_option_names": ["-h", "--help"]},
+             epilog="The scene format, with every key and default: docs/scene-format.md in the rtcli folder.")
 @click.version_option(__version__, prog_name="rtcli")
 @click.option("--debug", is_flag=True, help="Show a traceback on errors.")
 def main(debug):
-    """rtcli: a Whitted ray tracer for YAML scene files."""
+    """rtcli: a Whitted ray tracer for YAML scene files.
+
+    Try `rtcli render scenes/whitted.yaml`; `rtcli COMMAND --help` tells more.
+    """
     # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
 def _load(path):
-    from rtcli.scenefile.build import load_scene
-    return load_scene(path)
+    """(scene, real paths of every file it read)."""
+    from rtcli.scenefile.build import load_scene_and_inputs
+    return load_scene_and_inputs(path)
+
+
+def _not_empty(ctx, param, value):
+    if value is not None and not value.strip():
+        raise click.BadParameter("must not be empty", ctx, param)
+    return value
 
 
 def _output(scene_path: str, out: str | None, suffix: str = ".png") -> str:
-    out = out or os.path.splitext(os.path.basename(scene_path))[0] + suffix
-    folder = os.path.dirname(os.path.abspath(out))
-    if not os.path.isdir(folder):
-        raise RtcliError(f"{out}: output folder does not exist")
-    return out
+    return out or os.path.splitext(os.path.basename(scene_path))[0] + suffix
+
+
+def _check_outputs(outputs, inputs) -> None:
+    from rtcli.outputs import check_outputs
+    check_outputs(outputs, inputs)
+
+
+def _size(scene, width, height) -> tuple[int, int]:
+    """The image size: the scene's, with --width or --height alone keeping its aspect ratio."""
+    from rtcli.scenefile.build import camera_form, check_image_size
+    sw, sh = scene.settings.width, scene.settings.height
+    w = width or (max(1, round(height * sw / sh)) if height else sw)
+    h = height or (max(1, round(width * sh / sw)) if width else sh)
+    for given, name, other, value in ((width, "--width", "height", h), (height, "--height", "width", w)):
+        if given and value > 32768:
+            raise RtcliError(f"{name} {given} makes the {other} {value} (keeping the scene's {sw}x{sh} "
+                             "aspect ratio), more than 32768")
+    if (why := check_image_size(w, h)) is not None:
+        raise RtcliError(why)
+    form = camera_form(scene)
+    if width and height and w * sh != h * sw and form != "fov":
+        click.echo(f"note: the {form} camera keeps its rectangle, so the {sw}x{sh} scene stretches "
+                   f"to {w}x{h}", err=True)
+    return w, h
 
 
 def _job(scene, width, height, block_size, **kw):
     from rtcli.render import Job
-    width = width or scene.settings.width
-    height = height or scene.settings.height
-    return Job(width, height, block_size, **kw)
+    return Job(*_size(scene, width, height), block_size, **kw)
+
+
+def _check_engine(engine: str) -> None:
+    from rtcli import variants
+    if engine == "compiled" and not variants.ENABLED:
+        raise RtcliError(f"--engine compiled needs numba: {INSTALL.format(extra='fast')}")
 
 
 def _progress(enabled: bool, label: str):
@@ -83,7 +147,9 @@ def _progress(enabled: bool, label: str):
 
 @main.command()
 @click.argument("scene_file", metavar="SCENE.yaml")
-@click.option("-o", "--output", metavar="OUT.png", help="Output PNG (default: the scene's name .png).")
+@click.option("-o", "--output", metavar="OUT.png", callback=_not_empty,
+              help="Output image (default: the scene's name .png); the format follows the extension: "
+                   ".png, .jpg, .bmp, .tif, .webp or .ppm.")
 @click.option("--width", type=SIZE, help="Image width (the camera is kept).")
 @click.option("--height", type=SIZE, help="Image height (the camera is kept).")
 @click.option("--block-size", type=click.IntRange(1, 1024), default=1, show_default=True,
@@ -102,18 +168,20 @@ def _progress(enabled: bool, label: str):
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects: test each against every ray (for comparisons).")
 def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
            gamma, quiet, progress, stats, engine, no_bvh):
-    """Render SCENE.yaml to a PNG."""
+    """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format)."""
     from rtcli.render import render as render_image
     from rtcli.writer import write_png
     start = time.perf_counter()
-    scene = _load(scene_file)
+    _check_engine(engine)
+    scene, inputs = _load(scene_file)
     out = _output(scene_file, output)
+    _check_outputs([(out, False)], inputs)
     if samples:
         scene.settings.samples = samples
     if max_depth:
         scene.settings.max_depth = max_depth
     job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine, bvh=not no_bvh)
-    show = _progress(not quiet and (progress or sys.stderr.isatty()), os.path.basename(scene_file))
+    show = _progress(not quiet and (progress or sys.stderr.isatty()), one_line(os.path.basename(scene_file)))
     image, counts = render_image(scene, job, workers or os.cpu_count() or 1, show)
     write_png(out, image)
     if stats:
@@ -125,8 +193,10 @@ def render(scene_file, output, width, height, block_size, samples, max_depth, wo
 
 @main.command()
 @click.argument("scene_file", metavar="SCENE.yaml")
-@click.option("-o", "--output", metavar="OUT.png", help="Color-coded signature (default: NAME.sig.png).")
-@click.option("--ids", "ids_out", metavar="IDS.png", help="Also write the raw ids as a 16-bit gray PNG.")
+@click.option("-o", "--output", metavar="OUT.png", callback=_not_empty,
+              help="Color-coded signature (default: NAME.sig.png).")
+@click.option("--ids", "ids_out", metavar="IDS.png", callback=_not_empty,
+              help="Also write the raw ids as a 16-bit gray PNG.")
 @click.option("--legend", is_flag=True, help="Print id, name, shape and pixels covered.")
 @click.option("--width", type=SIZE, help="Image width (the camera is kept).")
 @click.option("--height", type=SIZE, help="Image height (the camera is kept).")
@@ -138,34 +208,31 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     import numpy as np
 
     from rtcli.render import render as render_image
-    from rtcli.writer import signature_colors, write_png
-    scene = _load(scene_file)
+    from rtcli.writer import signature_colors, write_images
+    scene, inputs = _load(scene_file)
     if len(scene.objects) > 65535:
-        raise RtcliError(f"{scene_file}: {len(scene.objects)} objects, but signature ids are 16-bit "
+        raise RtcliError(f"{shown(scene_file)}: {len(scene.objects)} objects, but signature ids are 16-bit "
                          "(at most 65535 objects)")
     out = _output(scene_file, output, ".sig.png")
-    if ids_out:
-        _output(scene_file, ids_out)
+    _check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), inputs)
     job = _job(scene, width, height, block_size, signature=True)
     ids, _ = render_image(scene, job, workers or os.cpu_count() or 1)
-    write_png(out, signature_colors(ids))
-    if ids_out:
-        write_png(ids_out, ids)
+    write_images([(out, signature_colors(ids))] + ([(ids_out, ids)] if ids_out else []))
     if legend:
         counts = np.bincount(ids.ravel(), minlength=len(scene.objects) + 1)
         click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
         click.echo(f"{0:>5}  {'(background)':<24} {'-':<10} {counts[0]:>9}")
         for o in scene.objects:
-            click.echo(f"{o.id:>5}  {o.name or '-':<24} {o.kind:<10} {counts[o.id]:>9}")
+            click.echo(f"{o.id:>5}  {one_line(o.name) or '-':<24} {o.kind:<10} {counts[o.id]:>9}")
 
 
 @main.command()
 @click.argument("actual", metavar="ACTUAL.png")
 @click.argument("expected", metavar="EXPECTED.png")
-@click.option("--diff", metavar="DIFF.png", help="Write a heat map of the difference.")
-@click.option("--flip", "flip_out", metavar="FLIP.png",
+@click.option("--diff", metavar="DIFF.png", callback=_not_empty, help="Write a heat map of the difference.")
+@click.option("--flip", "flip_out", metavar="FLIP.png", callback=_not_empty,
               help="Also write NVIDIA FLIP's perceptual error map and add its mean to the summary "
-                   "(needs flip-evaluator: pip install 'rtcli[flip]').")
+                   "(needs flip-evaluator: pip install -e '.[flip]' in the rtcli folder).")
 @click.option("--ids", "ids_mode", is_flag=True, help="Compare signature id maps (16-bit gray PNGs).")
 @click.option("--tolerance", type=click.IntRange(0, 255), default=2, show_default=True,
               help="A pixel is bad when a channel differs by more than this (of 255).")
@@ -181,7 +248,8 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
             max_cluster, max_boundary_mismatch, max_boundary_fraction):
     """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it."""
     from rtcli import compare as cmp
-    from rtcli.writer import write_png
+    from rtcli.writer import write_images
+    _check_outputs([(p, False) for p in (diff, flip_out) if p], [actual, expected])
     a, e = cmp.read_png(actual), cmp.read_png(expected)
     id_options = dict(max_boundary_mismatch=max_boundary_mismatch, max_boundary_fraction=max_boundary_fraction)
     image_options = dict(tolerance=tolerance, max_bad_pixels=max_bad_pixels,
@@ -192,12 +260,14 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
         result = cmp.compare(a, e, image_options, id_options)
     summary = result.summary
     comparable = a.shape == e.shape and a.ndim == 3            # pictures of the same size
+    pictures = []
     if diff and comparable:
-        write_png(diff, cmp.heat_map(a, e, tolerance))
+        pictures.append((diff, cmp.heat_map(a, e, tolerance)))
     if flip_out and comparable:
         picture, mean = cmp.flip_map(a, e)
-        write_png(flip_out, picture)
+        pictures.append((flip_out, picture))
         summary += f", mean FLIP {mean:.4f}"
+    write_images(pictures)
     click.echo(summary)
     if not result.ok:
         raise click.exceptions.Exit(1)
@@ -208,7 +278,7 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
 def validate(scene_file):
     """Parse and check a scene; print a summary. Renders nothing."""
     from rtcli.scenefile.build import summary
-    click.echo(f"{scene_file}: ok: {summary(_load(scene_file))}")
+    click.echo(f"{shown(scene_file)}: ok: {summary(_load(scene_file)[0])}")
 
 
 @main.command()

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from rtcli.errors import RtcliError
+from rtcli.errors import RtcliError, shown
 
 _EIGHT = np.ones((3, 3), dtype=int)     # 8-connectivity for ndimage.label
 
@@ -80,13 +80,38 @@ def _size_differs(actual: np.ndarray, expected: np.ndarray) -> Comparison | None
 
 
 def _largest_cluster(bad: np.ndarray) -> tuple[int, tuple[int, int] | None]:
-    """Size of the largest 8-connected cluster of True pixels and its first pixel."""
-    labels, count = ndimage.label(bad, structure=_EIGHT)
-    if count == 0:
+    """Size of the largest 8-connected cluster of True pixels and its first pixel.
+
+    Only the box around the bad pixels is labelled, so a few bad pixels in a big
+    image cost little memory.
+    """
+    rows, cols = np.flatnonzero(bad.any(axis=1)), np.flatnonzero(bad.any(axis=0))
+    if len(rows) == 0:
         return 0, None
+    y0, x0 = rows[0], cols[0]
+    labels, count = ndimage.label(bad[y0:rows[-1] + 1, x0:cols[-1] + 1], structure=_EIGHT)
     sizes = np.bincount(labels.ravel())[1:]
     best = int(np.argmax(sizes)) + 1
-    return int(sizes[best - 1]), _xy(np.argmax(labels.ravel() == best), bad.shape[1])
+    y, x = divmod(int(np.argmax(labels.ravel() == best)), labels.shape[1])
+    return int(sizes[best - 1]), (int(x + x0), int(y + y0))
+
+
+BAND = 512                              # rows compared at a time: small integer arrays, bounded memory
+MAX_PIXELS = 40_000_000                 # per image (8K UHD is 33.2 million); see read_png
+
+
+def _band_errors(actual: np.ndarray, expected: np.ndarray) -> tuple[np.ndarray, int]:
+    """Per pixel, the largest channel error |a - e| (uint8 for 8-bit images), and the sum of all
+    channel errors, computed in bands of rows with small integer types."""
+    small = actual.dtype == np.uint8 and expected.dtype == np.uint8
+    work, keep = (np.int16, np.uint8) if small else (np.int64, np.int64)
+    pixel_err = np.empty(actual.shape[:2], dtype=keep)
+    total = 0
+    for y in range(0, actual.shape[0], BAND):
+        d = np.abs(actual[y:y + BAND].astype(work) - expected[y:y + BAND].astype(work))
+        pixel_err[y:y + BAND] = d.max(axis=2)
+        total += int(d.sum(dtype=np.int64))
+    return pixel_err, total
 
 
 def compare_images(actual, expected, tolerance: int = 2, max_bad_pixels: int = 16,
@@ -97,14 +122,13 @@ def compare_images(actual, expected, tolerance: int = 2, max_bad_pixels: int = 1
     if (differs := _size_differs(actual, expected)) is not None:
         return differs
     h, w = actual.shape[:2]
-    err = np.abs(actual.astype(np.int64) - expected.astype(np.int64))
-    pixel_err = err.max(axis=2)
+    pixel_err, total = _band_errors(actual, expected)
     bad = pixel_err > tolerance
-    n_bad, limit = int(bad.sum()), _limit(max_bad_pixels, max_bad_fraction, h * w)
-    cluster, cluster_at = _largest_cluster(bad)
+    n_bad, limit = int(np.count_nonzero(bad)), _limit(max_bad_pixels, max_bad_fraction, h * w)
+    cluster, cluster_at = _largest_cluster(bad) if n_bad else (0, None)
     max_err = int(pixel_err.max()) if pixel_err.size else 0
     max_at = _xy(np.argmax(pixel_err), w) if max_err > 0 else None
-    mean = float(err.mean()) if err.size else 0.0
+    mean = total / (h * w * 3) if h * w else 0.0
     ok = n_bad <= limit and cluster <= max_cluster
     summary = (f"{'OK' if ok else 'FAIL'}: {n_bad} bad pixels (limit {limit}), "
                f"largest cluster {cluster} px{_at(cluster_at)}, "
@@ -175,44 +199,65 @@ def heat_map(actual, expected, tolerance: int = 2) -> np.ndarray:
     expected = _check(expected, 3, "expected", "an RGB image (H, W, 3)")
     if (differs := _size_differs(actual, expected)) is not None:
         raise RtcliError(differs.summary.removeprefix("FAIL: "))
-    e = np.abs(actual.astype(np.int64) - expected.astype(np.int64)).max(axis=2)
-    t = np.where(e > 0, np.minimum(255, 32 + 8 * e), 0)
-    t = np.where(e > tolerance, np.maximum(t, 128), t)
-    ramp = 3 * t[..., None] - np.array([0, 255, 510])
-    return np.clip(ramp, 0, 255).astype(np.uint8)
+    out = np.empty(actual.shape, dtype=np.uint8)
+    for y in range(0, actual.shape[0], BAND):
+        e = _band_errors(actual[y:y + BAND], expected[y:y + BAND])[0].astype(np.int32)
+        t = np.where(e > 0, np.minimum(255, 32 + 8 * e), 0)
+        t = np.where(e > tolerance, np.maximum(t, 128), t)
+        out[y:y + BAND] = np.clip(3 * t[..., None] - np.array([0, 255, 510], np.int32), 0, 255)
+    return out
 
 
 def read_png(path) -> np.ndarray:
     """Decode a PNG: uint8 RGB (H, W, 3) for color (RGBA, palette ... converted to RGB);
     the 2-D integer array for single-channel PNGs (modes I;16, I, L), as used by id mode.
 
-    Raises RtcliError naming the file if it is missing or not a readable PNG.
+    Raises RtcliError naming the file if it is missing, not a regular file, not a
+    readable PNG, or larger than MAX_PIXELS (checked from its header, before decoding):
+    a comparison holds both images (3 bytes per pixel each) and a few bytes per pixel
+    more, about 500 MB at the limit with --diff.
     """
+    import warnings
+
     from PIL import Image
+
+    from rtcli.scenefile.files import InputError, check_input
     try:
-        with Image.open(path) as img:
-            if img.format != "PNG":
-                raise RtcliError(f"{path}: not a PNG file (it is {img.format})")
-            img.load()
-            if img.mode in ("L", "I") or img.mode.startswith("I;16"):
-                return np.array(img)
-            return np.array(img.convert("RGB"))
+        check_input(path, 1 << 40)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(path) as img:
+                if img.format != "PNG":
+                    raise RtcliError(f"{shown(path)}: not a PNG file (it is {img.format})")
+                w, h = img.size
+                if w * h > MAX_PIXELS:
+                    raise RtcliError(f"{shown(path)}: {w}x{h} is {w * h:,} pixels, more than the {MAX_PIXELS:,} "
+                                     "rtcli compare accepts")
+                img.load()
+                if img.mode in ("L", "I") or img.mode.startswith("I;16"):
+                    return np.asarray(img)
+                return np.asarray(img if img.mode == "RGB" else img.convert("RGB"))
     except FileNotFoundError:
-        raise RtcliError(f"{path}: no such file") from None
-    except (OSError, ValueError, SyntaxError, EOFError, Image.DecompressionBombError) as exc:
+        raise RtcliError(f"{shown(path)}: no such file") from None
+    except InputError as exc:
+        raise RtcliError(f"{shown(path)}: cannot read: {exc}") from None
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning):
+        raise RtcliError(f"{shown(path)}: more than the {MAX_PIXELS:,} pixels rtcli compare accepts") from None
+    except (OSError, ValueError, SyntaxError, EOFError) as exc:
         reason = " ".join(str(exc).split()) or type(exc).__name__
-        raise RtcliError(f"{path}: not a readable PNG: {reason}") from None
+        raise RtcliError(f"{shown(path)}: not a readable PNG: {reason}") from None
 
 
 def flip_map(actual: np.ndarray, expected: np.ndarray) -> tuple[np.ndarray, float]:
     """NVIDIA FLIP's perceptual error map (magma colors, uint8) and its mean, for two RGB images.
 
-    Needs the optional flip-evaluator package (`pip install 'rtcli[flip]'`).
+    Needs the optional flip-evaluator package (`pip install -e '.[flip]'` in the rtcli folder).
     """
     try:
         import flip_evaluator
     except ImportError:
-        raise RtcliError("--flip needs the flip-evaluator package: pip install 'rtcli[flip]'") from None
+        raise RtcliError("--flip needs the flip-evaluator package: pip install -e '.[flip]' in the rtcli "
+                         "folder (rtcli is not on the package index)") from None
     if actual.ndim != 3 or actual.shape != expected.shape:
         raise RtcliError("--flip compares two RGB images of the same size")
     error, mean, _ = flip_evaluator.evaluate(expected.astype(np.float32) / 255,

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
+_PLAIN = re.compile(r"[\w./+@%,=:~-]+", re.ASCII)       # shown without quotes
 
-@dataclass(frozen=True)
+
+@dataclass(frozen=True, slots=True)
 class Where:
     """A place in a scene file: 1-based line and column."""
 
@@ -14,7 +17,35 @@ class Where:
     column: int
 
     def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.column}"
+        return f"{shown(self.file)}:{self.line}:{self.column}"
+
+
+def quoted(text) -> str:
+    """Text from the user (a key, a name) in quotes, with every control or
+    non-printable character escaped (Python's repr), so it stays on one line."""
+    return repr(str(text))
+
+
+def shown(text) -> str:
+    """A path or a key as it appears in a message: as it is when it is plain
+    (letters, digits and ./_-+@%,=:~), else quoted with escapes, so that a newline
+    or a quote in it can neither break the message's line nor forge another."""
+    text = str(text)
+    return text if _PLAIN.fullmatch(text) else quoted(text)
+
+
+def one_line(message: str) -> str:
+    """The message with any line break or other control character escaped: the last
+    guard of the rule that every error is one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
+
+
+class Interrupted(BaseException):
+    """SIGINT or SIGTERM arrived: unwind (workers stopped, temporary files removed); exit 128 + signum."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
 
 
 class RtcliError(Exception):
@@ -26,7 +57,7 @@ class SceneError(RtcliError):
 
     def __init__(self, where: Where | str | None, path: str, message: str):
         self.where, self.path, self.message = where, path, message
-        parts = [str(where)] if where else []
+        parts = [str(where) if isinstance(where, Where) else shown(where)] if where else []
         if path:
             parts.append(path)
         parts.append(message)

@@ -11,9 +11,11 @@ numpy engine (rtcli/wavefront/) or the compiled one (rtcli/compiled/) to trace t
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +24,7 @@ from rtcli import compiled, wavefront
 from rtcli.core.camera import primary_ray
 from rtcli.core.jitter import hash_pixel
 from rtcli.core.scene import Scene
+from rtcli.pool import stop_pool, watch_worker, worker_died
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays
@@ -69,21 +72,22 @@ def camera_rays(cam, x, y, nc: int, nr: int) -> Rays:
 def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
                 engine: compiled.Compiled | None = None) -> tuple[np.ndarray, Stats]:
     """Colors (or ids) of the pixels (i, j) of the full-size image; a compiled `engine` traces
-    them instead of the numpy engine when given."""
+    them instead of the numpy engine when given. The kernels make inf and NaN on purpose (a
+    ray parallel to a plane, a miss), so numpy's warnings about them are off."""
     stats = Stats()
     cam = scene.camera(job.width, job.height)
-    if job.signature:
-        rays = camera_rays(cam, i + 0.5, j + 0.5, job.width, job.height)
-        hits = find_first_hit(scene, rays)
-        stats.primary += len(rays)
-        ids = np.array([o.id for o in scene.objects] + [0], dtype=np.uint16)
-        return ids[hits.obj], stats
-    xs, ys = sample_positions(i, j, scene.settings.samples)
-    stats.primary += xs.size
-    if engine:
-        colors = engine.trace_pixels(cam, xs.ravel(), ys.ravel(), job.width, job.height, stats)
-    else:
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        if job.signature:
+            rays = camera_rays(cam, i + 0.5, j + 0.5, job.width, job.height)
+            hits = find_first_hit(scene, rays)
+            stats.primary += len(rays)
+            ids = np.array([o.id for o in scene.objects] + [0], dtype=np.uint16)
+            return ids[hits.obj], stats
+        xs, ys = sample_positions(i, j, scene.settings.samples)
+        stats.primary += xs.size
+        if engine:
+            colors = engine.trace_pixels(cam, xs.ravel(), ys.ravel(), job.width, job.height, stats)
+        else:
             colors = trace(scene, camera_rays(cam, xs.ravel(), ys.ravel(), job.width, job.height), 1, stats).T
     colors = colors.reshape(len(xs), len(i), 3)
     return colors.mean(axis=0), stats
@@ -117,6 +121,7 @@ _worker_scene = (None, None)               # the scene and its compiled form, se
 def _init_worker(scene: Scene, engine) -> None:
     global _worker_scene
     _worker_scene = (scene, engine)
+    watch_worker()
 
 
 def _worker_tile(job: Job, rows, cols):
@@ -138,12 +143,13 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     if not engine:
         wavefront.prepare(scene, job.bvh)
     stats.engine = "compiled" if engine else "numpy"            # add() keeps it
-    for done, (rows, cols, values, s) in enumerate(_map_tiles(scene, engine, job, tiles, workers), 1):
-        block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
-        image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
-        stats.add(s)
-        if progress:
-            progress(done, len(tiles))
+    with contextlib.closing(_map_tiles(scene, engine, job, tiles, workers)) as results:     # stops the pool
+        for done, (rows, cols, values, s) in enumerate(results, 1):
+            block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
+            image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
+            stats.add(s)
+            if progress:
+                progress(done, len(tiles))
     return image, stats
 
 
@@ -153,8 +159,14 @@ def _map_tiles(scene: Scene, engine, job: Job, tiles: list, workers: int):
             yield _run_tile(scene, engine, job, rows, cols)
         return
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
-    with ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
-                             initargs=(scene, engine)) as pool:
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(scene, engine))
+    finished = False
+    try:
         futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
         for f in as_completed(futures):
             yield f.result()
+        finished = True
+    except BrokenProcessPool:
+        raise worker_died(pool) from None
+    finally:
+        stop_pool(pool, finished)

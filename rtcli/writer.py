@@ -1,8 +1,11 @@
-"""Images out: 8-bit conversion, atomic PNG writing, the signature palette.
+"""Images out: 8-bit conversion, atomic image writing, the signature palette.
 
-PNG files carry no timestamp or other metadata, so the same pixels always give
-the same bytes. Files are written to a temporary name in the target folder and
-renamed into place, so a failed run never leaves a truncated image.
+The format follows the output's extension (FORMATS: PNG, and JPEG, BMP, TIFF,
+WebP, PPM for pictures), so a .jpg name never receives PNG bytes. Files carry
+no timestamp or other metadata, so the same pixels always give the same bytes.
+Files are written to a temporary name in the target folder and renamed into
+place, several outputs all or none, so a failed or interrupted run never leaves
+a truncated image, nor one output without the other.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ import tempfile
 import numpy as np
 from PIL import Image
 
-from rtcli.errors import RtcliError
+from rtcli.errors import RtcliError, quoted, shown
 
 
 def srgb_encode(c: np.ndarray) -> np.ndarray:
@@ -30,27 +33,86 @@ def to_8bit(image: np.ndarray, gamma: bool = False) -> np.ndarray:
     return np.rint(c * 255).astype(np.uint8)
 
 
+# extension -> (Pillow format, save options); 16-bit id maps go to PNG only
+FORMATS = {
+    ".png": ("PNG", {"compress_level": 3}),      # zlib's 6 takes twice as long for 13% fewer bytes
+    ".jpg": ("JPEG", {"quality": 95}),
+    ".jpeg": ("JPEG", {"quality": 95}),
+    ".bmp": ("BMP", {}),
+    ".tif": ("TIFF", {}),
+    ".tiff": ("TIFF", {}),
+    ".webp": ("WEBP", {"lossless": True}),
+    ".ppm": ("PPM", {}),
+}
+
+
+def image_format(path: str, ids: bool = False) -> tuple[str, dict]:
+    """(Pillow format, options) for an output's extension; RtcliError for an extension it is not."""
+    ext = os.path.splitext(path)[1].lower()
+    if ids and ext != ".png":
+        raise RtcliError(f"{shown(path)}: an id map is written as a 16-bit PNG: the name must end in .png")
+    if ext not in FORMATS:
+        names = ", ".join(FORMATS)
+        got = f"{quoted(ext)} is not one of" if ext else "no extension; use one of"
+        raise RtcliError(f"{shown(path)}: the output format follows the extension: {got} {names}")
+    return FORMATS[ext]
+
+
 def write_png(path: str, pixels: np.ndarray) -> None:
-    """Write uint8 (H, W, 3) as RGB or uint16 (H, W) as 16-bit gray, atomically."""
+    """Write one image atomically, in the format its extension names (see write_images)."""
+    write_images([(path, pixels)])
+
+
+def write_images(items: list[tuple[str, np.ndarray]]) -> None:
+    """Write uint8 (H, W, 3) as RGB or uint16 (H, W) as 16-bit gray, each in the format of its
+    extension, all or none: every image goes to a temporary file in its folder first, and
+    only when all are written are they renamed into place; on any failure, or an
+    interrupt, the temporary files and any image already renamed are removed."""
+    temps, placed = [], []
+    try:
+        for path, pixels in items:
+            temps.append((_write_temp(path, pixels), path))
+        for tmp, path in temps:
+            os.replace(tmp, path)
+            placed.append(path)
+    except BaseException as e:
+        for tmp, _ in temps:
+            _remove(tmp)
+        for path in placed:
+            _remove(path)
+        if isinstance(e, OSError):
+            failed = items[len(placed) if len(temps) == len(items) else len(temps)][0]
+            raise RtcliError(f"cannot write {shown(failed)}: {e.strerror or e}") from None
+        raise
+
+
+def _write_temp(path: str, pixels: np.ndarray) -> str:
+    """The image written to a new temporary file beside `path`; its name."""
     if not ((pixels.dtype == np.uint16 and pixels.ndim == 2)
             or (pixels.dtype == np.uint8 and pixels.ndim == 3 and pixels.shape[2] == 3)):
-        raise ValueError(f"cannot write {pixels.dtype} pixels of shape {pixels.shape} as PNG")
+        raise ValueError(f"cannot write {pixels.dtype} pixels of shape {pixels.shape} as an image")
+    fmt, options = image_format(path, ids=pixels.dtype == np.uint16)
     img = Image.fromarray(pixels)                      # uint16 (H, W) -> I;16, uint8 (H, W, 3) -> RGB
     folder = os.path.dirname(os.path.abspath(path))
     try:
-        fd, tmp = tempfile.mkstemp(prefix=".rtcli-", suffix=".png", dir=folder)
+        fd, tmp = tempfile.mkstemp(prefix=".rtcli-", suffix=os.path.splitext(path)[1], dir=folder)
     except OSError as e:
-        raise RtcliError(f"cannot write {path}: {e.strerror}") from None
+        raise RtcliError(f"cannot write {shown(path)}: {e.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as f:
-            img.save(f, format="PNG", compress_level=3)  # zlib's 6 takes twice as long for 13% fewer bytes
+            img.save(f, format=fmt, **options)
         os.chmod(tmp, 0o666 & ~_umask())               # as a plain open() would (mkstemp makes 0600)
-        os.replace(tmp, path)
-    except BaseException as e:
-        os.unlink(tmp)
-        if isinstance(e, OSError):
-            raise RtcliError(f"cannot write {path}: {e.strerror or e}") from None
+    except BaseException:
+        _remove(tmp)
         raise
+    return tmp
+
+
+def _remove(path: str) -> None:
+    try:
+        os.unlink(path)
+    except OSError:
+        pass
 
 
 def _umask() -> int:

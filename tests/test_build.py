@@ -110,12 +110,12 @@ def test_missing_required_key(text, expected):
 # --- numbers out of range ---
 BAD_NUMBER = {
     "inf": (obj("sphere: {radius: .inf}"),
-            "scene.yaml:3:22: objects[0].sphere.radius: must be finite, got inf"),
+            "scene.yaml:3:22: objects[0].sphere.radius: must be a finite number between -1e20 and 1e20, got inf"),
     "nan": (obj("sphere: {radius: .nan}"),
-            "scene.yaml:3:22: objects[0].sphere.radius: must be finite, got nan"),
+            "scene.yaml:3:22: objects[0].sphere.radius: must be a finite number between -1e20 and 1e20, got nan"),
     #          "  - sphere: {center: [0, .nan, 0]}": '.nan' at 26
     "nan_in_vector": (obj("sphere: {center: [0, .nan, 0]}"),
-                      "scene.yaml:3:26: objects[0].sphere.center[1]: must be a finite number, got nan"),
+                      "scene.yaml:3:26: objects[0].sphere.center[1]: must be a finite number between -1e20 and 1e20, got nan"),
     "radius_0": (obj("sphere: {radius: 0}"),
                  "scene.yaml:3:22: objects[0].sphere.radius: must be > 0, got 0"),
     "radius_negative": (obj("sphere: {radius: -1}"),

@@ -187,7 +187,7 @@ def test_yaml_folder_and_latin1_comment(tmp_path):
     (tmp_path / "m.obj").write_bytes(b"# caf\xe9\n" + (TRIANGLE + "f 1 2 3\n").encode())
     assert len(shape_from(mesh_params(tmp_path, "{file: m.obj}"), Mesh)) == 1
     (tmp_path / "dir.obj").mkdir()
-    with pytest.raises(SceneError, match=r"mesh\.file: cannot read .*dir\.obj: Is a directory"):
+    with pytest.raises(SceneError, match=r"mesh\.file: cannot read .*dir\.obj: not a regular file but a folder"):
         shape_from(mesh_params(tmp_path, "{file: dir.obj}"), Mesh)
 
 

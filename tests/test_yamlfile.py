@@ -152,3 +152,32 @@ def test_load_returns_included_documents_first(tmp_path):
                                             str(tmp_path / "sub" / "common.yaml"),
                                             str(tmp_path / "scene.yaml")]
     assert docs[0].folder == str(tmp_path / "sub")
+
+
+# --- the event-built tree reads YAML as PyYAML's safe loader does ---
+class _PyYAML(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
+    """PyYAML's own safe loader with rtcli's one extra rule (1e-6 is a float)."""
+
+
+_PyYAML.add_implicit_resolver("tag:yaml.org,2002:float",
+                              __import__("re").compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+                              list("-+0123456789"))
+
+SCALARS = ["1", "-1", "+1", "0", "-0", "00", "017", "0x1F", "0b101", "1_000", "1:20", "190:20:30.15",
+           "123456789012345678", "1234567890123456789012", "1.5", "-1.5", "1.", ".5", "-.5", "01.50", "1e5",
+           "1E-6", "-3e2", "1.5e3", "1_0.5", ".inf", "-.Inf", ".nan", "yes", "No", "on", "OFF", "true",
+           "null", "~", "", "2001-12-14", "2001-12-14t21:59:43.10-05:00", "abc", "'1'", '"2.5"', "!!str 3",
+           "!!float 1", "<<x", "1.2.3"]
+
+
+@pytest.mark.parametrize("scalar", SCALARS)
+def test_scalars_read_as_pyyaml_reads_them(scalar):
+    text = f"a: {scalar}\n"
+    assert yamlfile.parse(text, "s.yaml") == yaml.load(text, Loader=_PyYAML)
+
+
+def test_anchors_merges_and_nesting_read_as_pyyaml_reads_them():
+    text = ("base: &b {x: 1, y: [1, 2, {z: 3}]}\nother: &o {y: 9, w: 4}\n"
+            "m: {<<: [*b, *o], x: 7}\nn: {<<: *o}\nl: [*b, *o, [*b]]\nk: &k 5\nj: *k\n"
+            "deep: {a: {b: {c: [[[]], {}]}}}\n")
+    assert yamlfile.parse(text, "s.yaml") == yaml.load(text, Loader=_PyYAML)

@@ -1,7 +1,7 @@
 """Ray-scene queries of the compiled engine, one ray at a time: the nearest hit and shadow feelers.
 
 The same questions as rtcli/wavefront/intersect.py asks for arrays of rays. The
-listed objects (planes, or all objects of a scene without an Accelerator) are tested
+listed objects (planes, or all objects of a scene without a BVH) are tested
 one by one, the others through the scene's BVH, meshes through their own BVH (two
 levels): one walk (rtcli/core/bvh.py), specialised here for scene objects and for
 triangles. A tie (two objects hit at the very same t, say coplanar faces) goes to the

@@ -7,6 +7,7 @@ Params, so unknown keys are reported with file:line:col.
 from __future__ import annotations
 
 import functools
+import gc
 
 import numpy as np
 
@@ -15,15 +16,47 @@ from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
 from rtcli.scenefile import yamlfile
+from rtcli.scenefile.files import recording_inputs
+from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
 from rtcli.scenefile.objects import ObjectBuilder, material_from
-from rtcli.scenefile.params import Params, as_params
-
-MAX_SIZE = 32768
+from rtcli.scenefile.params import Params, as_params, describe
 
 
 def load_scene(path: str) -> Scene:
     """Read, check and build the scene at `path` (with its includes)."""
-    return scene_from_docs(yamlfile.load(path))
+    return load_scene_and_inputs(path)[0]
+
+
+def load_scene_and_inputs(path: str) -> tuple[Scene, list[str]]:
+    """The scene, and the real paths of every file it read (scene, includes, meshes, textures).
+
+    The cyclic garbage collector is paused meanwhile: loading makes no cycles, and
+    the collector would otherwise walk the growing tree again and again (a third
+    of the time of a 100,000-object scene).
+    """
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        with recording_inputs() as inputs:
+            scene = scene_from_docs(yamlfile.load(path))
+    finally:
+        if collecting:
+            gc.enable()
+    return scene, inputs
+
+
+def check_image_size(width: int, height: int) -> str | None:
+    """Why a width x height image is refused (see limits.MAX_PIXELS), or None."""
+    if width * height <= MAX_PIXELS:
+        return None
+    return (f"{width}x{height} is {width * height:,} pixels, more than the {MAX_PIXELS:,} allowed "
+            "(16384 x 16384; rendering keeps the whole image in memory)")
+
+
+def camera_form(scene: Scene) -> str:
+    """'fov', 'window' or 'screen': which of the three camera forms the scene uses."""
+    forms = {cameras.from_fov: "fov", cameras.from_window: "window", cameras.from_screen: "screen"}
+    return forms.get(getattr(scene.camera, "func", None), "fov")
 
 
 def scene_from_docs(docs: list) -> Scene:
@@ -32,7 +65,7 @@ def scene_from_docs(docs: list) -> Scene:
     main = params[-1]
     for p in params:
         if p.has("version") and p.raw("version") != 1:
-            raise p.error("version", f"unsupported version {p.raw('version')!r} (this is version 1)")
+            raise p.error("version", f"unsupported version {describe(p.raw('version'))} (this is version 1)")
         p.known("version", "include")
     named, table = {}, [Material()]
     for p in params:
@@ -63,8 +96,10 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
     settings = Settings()
     img = p.optional("image")
     if img is not None:
-        settings.width = img.integer("width", 640, 1, MAX_SIZE)
-        settings.height = img.integer("height", 480, 1, MAX_SIZE)
+        settings.width = img.integer("width", 640, 1, MAX_SIDE)
+        settings.height = img.integer("height", 480, 1, MAX_SIDE)
+        if (why := check_image_size(settings.width, settings.height)) is not None:
+            raise img.error(None, why)
         img.check_unused()
     r = p.optional("render")
     if r is not None:
@@ -74,6 +109,7 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
         settings.epsilon = r.number("epsilon", 1e-6, positive=True)
         r.check_unused()
     camera, eye = camera_from(p.sub("camera"))
+    check_resolvable(p, camera, settings.width, settings.height)
     return Scene(camera=camera, objects=builder.objects, materials=MaterialTable(table),
                  lights=lights, background=p.color("background", (0.0, 0.0, 0.0)),
                  ambient=p.color("ambient", (0.1, 0.1, 0.1)), settings=settings, eye=eye)
@@ -111,6 +147,23 @@ def camera_from(c: Params):
         raise c.error("fov", f"must be between 0 and 180 degrees, got {fov:g}")
     c.check_unused()
     return functools.partial(cameras.from_fov, eye, look_at, up, fov), eye
+
+
+def check_resolvable(p: Params, camera, width: int, height: int) -> None:
+    """Refuse a camera whose pixels are finer than the rounding of its image-plane points.
+
+    Rays go from the eye to points of the image plane, p - eye. With the eye very
+    far from the origin compared with a pixel of the plane (an eye at 1e17 and a
+    plane one unit away), those points round to a grid coarser than the pixels:
+    neighbouring pixels would get the same ray, or rays no direction at all.
+    """
+    cam = camera(width, height)
+    rounding = np.spacing(max(np.abs(cam.eye).max(), np.abs(cam.origin).max()))
+    pixel = min(np.linalg.norm(cam.right) / width, np.linalg.norm(cam.down) / height)
+    if not 4 * rounding < pixel:
+        raise p.error("camera", "the eye is too far from the origin for the size of its image plane: "
+                                "neighbouring pixels would get the same ray in double precision (bring the "
+                                "scene nearer the origin, or make the window or fov larger)")
 
 
 def light_from(p: Params) -> PointLight:

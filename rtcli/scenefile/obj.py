@@ -18,7 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.errors import SceneError, Where
+from rtcli.errors import SceneError, Where, quoted
+from rtcli.scenefile.files import read_bytes
+from rtcli.scenefile.limits import MAX_MESH_BYTES
 
 _READ = {"v": 3, "vt": 1, "vn": 3}      # statement -> how many numbers it needs at least
 _KEEP = {"v": 3, "vt": 2, "vn": 3}      # statement -> how many numbers are kept (vt's v defaults to 0)
@@ -65,12 +67,12 @@ def parse_obj(text: str, display: str) -> ObjData:
 
 
 def read_obj(path: str, display: str | None = None) -> ObjData:
-    """Read and parse an OBJ file (OSError if it cannot be read).
+    """Read and parse an OBJ file (OSError if it cannot be read, is not a regular
+    file or is larger than MAX_MESH_BYTES).
 
     OBJ is ASCII; bytes that are not UTF-8 (in comments, say) are replaced, not refused.
     """
-    with open(path, encoding="utf-8", errors="replace") as f:
-        return parse_obj(f.read(), display or path)
+    return parse_obj(read_bytes(path, MAX_MESH_BYTES).decode("utf-8", errors="replace"), display or path)
 
 
 def _statements(lines: list[str]) -> dict[str, tuple[list[int], list[list[str]]]]:
@@ -102,7 +104,7 @@ def _numbers(src: _Source, kw: str, line_nos: list[int], args: list[list[str]]) 
         for no, a in zip(line_nos, args):
             for k, x in enumerate(a[:keep]):
                 if not _finite(x):
-                    raise src.error(no, k, f"bad number '{x}' in '{kw}'")
+                    raise src.error(no, k, f"bad number {quoted(x)} in '{kw}'")
     return out
 
 
@@ -128,7 +130,7 @@ def _faces(src, line_nos, args, counts, totals):
     fields = _fields(tokens, at)
     if (fields[0] == _MISSING).any():
         k = int(np.argmax(fields[0] == _MISSING))
-        raise at(k, f"face corner '{tokens[k]}' has no vertex index")
+        raise at(k, f"face corner {quoted(tokens[k])} has no vertex index")
     idx = [_resolve(f, np.repeat(c, corners), n, names, at)
            for f, c, n, names in zip(fields, counts, totals, _NAMES)]
     tri = _fan(corners)
@@ -144,7 +146,7 @@ def _fields(tokens, at):
         slashes = [t.count("/") for t in tokens]
         if max(slashes) > 2:
             k = int(np.argmax(np.array(slashes) > 2))
-            raise at(k, f"bad face corner '{tokens[k]}' (more than v/vt/vn)")
+            raise at(k, f"bad face corner {quoted(tokens[k])} (more than v/vt/vn)")
         parts = "/".join(t + pad[s] for t, s in zip(tokens, slashes)).split("/")
         texts = [[x or _MISSING_TEXT for x in parts[j::3]] for j in range(3)]
     out = []
@@ -156,7 +158,7 @@ def _fields(tokens, at):
             out.append(np.array(text, dtype=np.int64))
         except (ValueError, OverflowError):
             k = next(i for i, x in enumerate(text) if not _is_index(x))
-            raise at(k, f"bad index in face corner '{tokens[k]}'") from None
+            raise at(k, f"bad index in face corner {quoted(tokens[k])}") from None
     return out
 
 

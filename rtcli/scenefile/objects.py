@@ -11,17 +11,20 @@ from __future__ import annotations
 import os
 
 import numpy as np
-from PIL import Image, UnidentifiedImageError
+from PIL import UnidentifiedImageError
 
 from rtcli.core import transform as tf
 from rtcli.core.materials import Material
 from rtcli.core.scene import SceneObject
 from rtcli.core.textures import Checker, ImageTexture
-from rtcli.errors import SceneError
+from rtcli.errors import SceneError, quoted, shown
 from rtcli.scenefile import params as required
+from rtcli.scenefile.files import open_image
+from rtcli.scenefile.guards import bounded, check_count, scale_factors
 from rtcli.scenefile.obj import read_obj
 from rtcli.scenefile.params import Params, as_params, describe
 from rtcli.scenefile.presets import PRESETS
+from rtcli.scenefile.yamlfile import MapNode
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import REQUIRED, ParamError
 from rtcli.shapes.csg import CSG, OPS, Child
@@ -36,7 +39,7 @@ def material_from(p: Params) -> Material:
     if p.has("preset"):
         name = p.string("preset")
         if name not in PRESETS:
-            raise p.error("preset", f"unknown preset '{name}' (see `rtcli presets`)")
+            raise p.error("preset", f"unknown preset {quoted(name)} (see `rtcli presets`)")
         pre = PRESETS[name]
         base = dict(ambient=pre.ambient, diffuse=pre.diffuse, specular=pre.specular, shininess=pre.shininess)
     else:
@@ -49,8 +52,8 @@ def material_from(p: Params) -> Material:
         specular=p.coefficient("specular", base.get("specular", 0.0)),
         shininess=p.number("shininess", base.get("shininess", 32.0), non_negative=True),
         emission=p.color("emission", (0.0, 0.0, 0.0)),
-        reflection=p.coefficient("reflection", 0.0),
-        transmission=p.coefficient("transmission", 0.0),
+        reflection=p.coefficient("reflection", 0.0, at_most=1),      # at most 1: no light grows along a path
+        transmission=p.coefficient("transmission", 0.0, at_most=1),
         ior=p.number("ior", 1.0, positive=True),
         shadow=p.boolean("shadow", True),
         texture=None if texture is None else texture_from(texture),
@@ -80,12 +83,12 @@ def texture_from(p: Params):
 def load_texels(p: Params, key: str) -> np.ndarray:
     path = os.path.join(p.folder, p.string(key))
     try:
-        with Image.open(path) as img:
+        with open_image(path) as img:
             return np.asarray(img.convert("RGB"), dtype=float) / 255.0
     except FileNotFoundError:
-        raise p.error(key, f"file not found: {path}") from None
+        raise p.error(key, f"file not found: {shown(path)}") from None
     except (UnidentifiedImageError, OSError) as e:
-        raise p.error(key, f"cannot read image {path}: {e}") from None
+        raise p.error(key, f"cannot read image {shown(path)}: {e}") from None
 
 
 def material_ref(p: Params, key: str, named: dict, table: list, default: int) -> int:
@@ -96,7 +99,7 @@ def material_ref(p: Params, key: str, named: dict, table: list, default: int) ->
     value = p.raw(key)
     if isinstance(value, str):
         if value not in named:
-            raise p.error(key, f"unknown material '{value}'")
+            raise p.error(key, f"unknown material {quoted(value)}")
         return named[value]
     table.append(material_from(p.sub(key)))
     return len(table) - 1
@@ -112,7 +115,7 @@ def transform_from(p: Params) -> tf.Transform | None:
     for item, where, path in p.items("transform"):
         step = as_params(item, where, path, "a mapping with one of: scale, rotate, translate, matrix")
         total = total.then(_one_transform(step))
-    return total
+    return bounded(p, total)
 
 
 def _one_transform(p: Params) -> tf.Transform:
@@ -126,7 +129,7 @@ def _one_transform(p: Params) -> tf.Transform:
         if kind == "scale":
             value = p.raw("scale")
             s = p.number("scale") if not isinstance(value, list) else p.vector("scale")
-            return tf.scale(s)
+            return tf.scale(scale_factors(p, s))
         if kind == "rotate":
             r = p.sub("rotate")
             axis, degrees = r.vector("axis"), r.number("degrees")
@@ -176,16 +179,16 @@ def shape_from(p: Params, cls):
         return cls.from_values(**values)
     except ParamError as e:
         key = next((k for k in e.keys if p.has(k)), e.keys[-1])
-        raise p.error(key, f"{e}: {files[key]}" if key in files else str(e)) from None
+        raise p.error(key, f"{e}: {shown(files[key])}" if key in files else str(e)) from None
 
 
 def _read_mesh_file(p: Params, key: str, path: str):
     try:
         return read_obj(path)
     except FileNotFoundError:
-        raise p.error(key, f"file not found: {path}") from None
+        raise p.error(key, f"file not found: {shown(path)}") from None
     except OSError as e:
-        raise p.error(key, f"cannot read {path}: {e.strerror}") from None
+        raise p.error(key, f"cannot read {shown(path)}: {e.strerror or e}") from None
 
 
 def csg_from(p: Params, builder: "ObjectBuilder", material: int) -> CSG:
@@ -216,13 +219,14 @@ class ObjectBuilder:
 
     def add_all(self, items, parent: tf.Transform | None = None, material: int | None = None):
         for item, where, path in items:
+            check_count(self.objects, where, path)
             self.add(as_params(item, where, path, "an object (a mapping with a shape key)"), parent,
                      self.default if material is None else material)
 
     def add(self, p: Params, parent, inherited: int) -> None:
         kind = self._kind(p)
         p.string("name", "")
-        world = _compose(transform_from(p), parent)
+        world = bounded(p, _compose(transform_from(p), parent))
         material = material_ref(p, "material", self.named, self.table, inherited)
         if kind == "group":
             g = self._shape_params(p, kind)
@@ -268,10 +272,7 @@ class ObjectBuilder:
     def _shape_params(p: Params, kind: str) -> Params:
         if p.node[kind] is None:
             p.known(kind)
-            empty = type(p.node)()
-            empty.where, empty.key_where, empty.value_where = p.node.value_where[kind], {}, {}
-            empty.folder = p.folder
-            return Params(empty, p.key_path(kind))
+            return Params(MapNode.empty(p.node.value_where[kind], p.folder), p.key_path(kind))
         return p.sub(kind)
 
 

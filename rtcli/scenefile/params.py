@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-from rtcli.errors import SceneError, Where
+from rtcli.errors import SceneError, Where, quoted, shown
+from rtcli.scenefile.limits import MAX_MAGNITUDE, RANGE
 from rtcli.scenefile.yamlfile import MapNode, SeqNode
 
 REQUIRED = object()
@@ -22,6 +23,24 @@ def _is_number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
+def out_of_range(x) -> str | None:
+    """Why the number x is refused (not finite, or beyond +-MAX_MAGNITUDE), or None.
+
+    The limit keeps squares and higher powers of lengths finite (docs/scene-format.md,
+    "Limits"); a huge integer is judged without converting it to a float.
+    """
+    if isinstance(x, int):
+        if abs(x) <= MAX_MAGNITUDE:
+            return None
+        digits = len(str(abs(x))) if x.bit_length() < 10000 else int(x.bit_length() * 0.30103) + 1
+        return f"must be {RANGE}, got an integer of {digits} digits"
+    if not math.isfinite(x):
+        return f"must be a finite number {RANGE}, got {x}"
+    if abs(x) > MAX_MAGNITUDE:
+        return f"must be {RANGE}, got {x:g}"
+    return None
+
+
 def describe(x) -> str:
     """How a wrong value is shown in a message."""
     if isinstance(x, MapNode):
@@ -29,10 +48,14 @@ def describe(x) -> str:
     if isinstance(x, SeqNode):
         return f"a list of {len(x)}"
     if isinstance(x, str):
-        return repr(x)
+        return quoted(x)
     if x is None:
         return "nothing"
-    return str(x).lower() if isinstance(x, bool) else repr(x)
+    if isinstance(x, bool):
+        return str(x).lower()
+    if isinstance(x, int) and x.bit_length() > 64:
+        return f"an integer of about {int(x.bit_length() * 0.30103) + 1} digits"
+    return quoted(x) if not isinstance(x, (int, float)) else repr(x)
 
 
 class Params:
@@ -55,7 +78,7 @@ class Params:
         return self.node.where
 
     def key_path(self, key: str) -> str:
-        return f"{self.path}.{key}" if self.path else key
+        return f"{self.path}.{shown(key)}" if self.path else shown(key)
 
     def error(self, key: str | None, message: str) -> SceneError:
         """An error located at `key`'s value (or at the mapping when key is None)."""
@@ -90,7 +113,7 @@ class Params:
         for key in self.node:
             if key not in self.read:
                 close = difflib.get_close_matches(key, sorted(self.read), n=1)
-                hint = f" (did you mean '{close[0]}'?)" if close else ""
+                hint = f" (did you mean {quoted(close[0])}?)" if close else ""
                 raise SceneError(self.node.key_where[key], self.key_path(key), f"unknown key{hint}")
 
     # --- typed getters ---
@@ -104,8 +127,8 @@ class Params:
     def _check_number(self, key, x, positive=False, non_negative=False, what="a number"):
         if not _is_number(x):
             raise self.error(key, f"must be {what}, got {describe(x)}")
-        if not math.isfinite(x):
-            raise self.error(key, f"must be finite, got {x}")
+        if (why := out_of_range(x)) is not None:
+            raise self.error(key, why)
         if positive and x <= 0:
             raise self.error(key, f"must be > 0, got {x:g}")
         if non_negative and x < 0:
@@ -118,7 +141,7 @@ class Params:
         if not isinstance(x, int) or isinstance(x, bool):
             raise self.error(key, f"must be an integer, got {describe(x)}")
         if (lo is not None and x < lo) or (hi is not None and x > hi):
-            raise self.error(key, f"must be in {lo}..{hi}, got {x}")
+            raise self.error(key, f"must be in {lo}..{hi}, got {describe(x)}")
         return x
 
     def boolean(self, key, default=REQUIRED) -> bool:
@@ -181,7 +204,7 @@ class Params:
             return np.array(x, dtype=float)
         return self.color_value(key, x, self.key_path(key), self.node.value_where.get(key, self.node.where))
 
-    def color_value(self, key, x, label, where, allow_scalar=False) -> np.ndarray:
+    def color_value(self, key, x, label, where, allow_scalar=False, at_most=None) -> np.ndarray:
         if isinstance(x, str):
             if len(x) == 7 and x[0] == "#":
                 try:
@@ -194,19 +217,18 @@ class Params:
         if not isinstance(x, list) or len(x) != 3:
             raise SceneError(where, label, f"must be a color [r, g, b] or \"#rrggbb\", got {describe(x)}")
         for k, v in enumerate(x):
-            item_where = x.item_where[k] if isinstance(x, SeqNode) else where
-            if not _is_number(v) or not math.isfinite(v) or v < 0:
-                raise SceneError(item_where, f"{label}[{k}]",
-                                 f"must be a finite number >= 0, got {describe(v)}")
+            if (why := _channel_problem(v, at_most)) is not None:
+                item_where = x.item_where[k] if isinstance(x, SeqNode) else where
+                raise SceneError(item_where, f"{label}[{k}]", why)
         return np.array(x, dtype=float)
 
-    def coefficient(self, key, default=REQUIRED) -> np.ndarray:
-        """A color or one number k meaning [k, k, k]."""
+    def coefficient(self, key, default=REQUIRED, at_most=None) -> np.ndarray:
+        """A color or one number k meaning [k, k, k]; each at most `at_most` when given."""
         x = self.raw(key, default)
         if x is default and default is not REQUIRED:
             return np.broadcast_to(np.array(x, dtype=float), (3,)).copy()
-        return self.color_value(key, x, self.key_path(key),
-                                self.node.value_where.get(key, self.node.where), allow_scalar=True)
+        return self.color_value(key, x, self.key_path(key), self.node.value_where.get(key, self.node.where),
+                                allow_scalar=True, at_most=at_most)
 
     def sub(self, key, default=REQUIRED) -> Params | None:
         """The nested mapping at `key` as Params."""
@@ -227,14 +249,26 @@ class Params:
         return [(v, x.item_where[k], f"{self.key_path(key)}[{k}]") for k, v in enumerate(x)]
 
 
+def _channel_problem(v, at_most=None) -> str | None:
+    """Why v is refused as a channel of a color or coefficient, or None."""
+    if not _is_number(v) or (isinstance(v, float) and not math.isfinite(v)) or v < 0:
+        return f"must be a finite number >= 0, got {describe(v)}"
+    if (why := out_of_range(v)) is not None:
+        return why
+    if at_most is not None and v > at_most:
+        return f"must be at most {at_most:g}, got {v:g}"
+    return None
+
+
 def finite_numbers(x, where: Where, label: str, count: int, what: str) -> np.ndarray:
-    """x as an array if it is a list of exactly `count` finite numbers, else a located error."""
+    """x as an array if it is a list of exactly `count` numbers within +-MAX_MAGNITUDE, else a located error."""
     if not isinstance(x, list) or len(x) != count:
         raise SceneError(where, label, f"must be {what}, got {describe(x)}")
     for k, v in enumerate(x):
-        item_where = x.item_where[k] if isinstance(x, SeqNode) else where
-        if not _is_number(v) or not math.isfinite(v):
-            raise SceneError(item_where, f"{label}[{k}]", f"must be a finite number, got {describe(v)}")
+        if not _is_number(v) or out_of_range(v) is not None:
+            item_where = x.item_where[k] if isinstance(x, SeqNode) else where
+            why = out_of_range(v) if _is_number(v) else f"must be a finite number, got {describe(v)}"
+            raise SceneError(item_where, f"{label}[{k}]", why)
     return np.array(x, dtype=float)
 
 

@@ -1,118 +1,81 @@
-"""Safe YAML loading that remembers where every node came from.
+"""Safe YAML loading that remembers where every value came from.
 
 Mappings load as `MapNode` (a dict) and sequences as `SeqNode` (a list); each
 records its own location and those of its keys and items, so any value can be
 reported as `file:line:col`. Anchors, aliases and merge keys (`<<`) work as in
 PyYAML's safe loader; Python object tags are refused. `include:` files are
-loaded first, relative to the including file's folder, with cycle detection.
+loaded first, relative to the including file's folder, each file once, with
+cycle detection.
+
+The tree is built straight from the parser's events (yamlevents.py), without
+PyYAML's node graph, and locations are kept packed in one array per mapping or
+list (nodes.py): a big scene costs little more than its values. Loading is bounded
+(docs/scene-format.md, "Limits"): values nest at most MAX_DEPTH deep, aliases
+(each counted as a copy of what it names) add at most ALIAS_BUDGET values, an
+alias may not name a collection that contains it, and files are size-limited
+regular files (limits.py, files.py).
 """
 
 from __future__ import annotations
 
 import os
-import re
 
 import yaml
 
-from rtcli.errors import SceneError, Where
+from rtcli.errors import SceneError, Where, shown
+from rtcli.scenefile.files import read_bytes
+from rtcli.scenefile.limits import MAX_INCLUDE_DEPTH, MAX_SCENE_BYTES
+from rtcli.scenefile.nodes import MapNode, SeqNode
+from rtcli.scenefile.yamlevents import Builder, Loader
+
+__all__ = ["MapNode", "SeqNode", "INCLUDABLE", "parse", "read_text", "load"]
 
 INCLUDABLE = {"version", "include", "materials", "lights", "objects"}
 
 
-class MapNode(dict):
-    """A YAML mapping with the locations of itself, its keys and its values."""
-
-    where: Where
-    key_where: dict
-    value_where: dict
-    folder: str                             # folder of the file it came from
-    duplicates: list                        # (key, where, where_first) of keys given twice; Params reports them
-
-
-class SeqNode(list):
-    """A YAML sequence with the locations of itself and its items."""
-
-    where: Where
-    item_where: list
-
-
-class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
-    """The safe loader (libyaml's parser when present) building MapNode/SeqNode; reads 1e-6 as a float."""
-
-
-_Loader.add_implicit_resolver(        # YAML 1.1 wants a dot in 1.0e-6; people write 1e-6
-    "tag:yaml.org,2002:float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
-    list("-+0123456789"),
-)
-
-
-def _where(loader: _Loader, mark) -> Where:
-    return Where(loader.display, mark.line + 1, mark.column + 1)
-
-
-def _construct_map(loader: _Loader, node: yaml.MappingNode) -> MapNode:
-    first, duplicates = {}, []
-    for key_node, _ in node.value:
-        if isinstance(key_node, yaml.ScalarNode) and key_node.tag != "tag:yaml.org,2002:merge":
-            where = _where(loader, key_node.start_mark)
-            if key_node.value in first:
-                duplicates.append((key_node.value, where, first[key_node.value]))
-            first.setdefault(key_node.value, where)
-    loader.flatten_mapping(node)
-    result = MapNode()
-    result.duplicates = duplicates
-    result.where = _where(loader, node.start_mark)
-    result.key_where, result.value_where = {}, {}
-    result.folder = loader.folder
-    for key_node, value_node in node.value:
-        key = loader.construct_object(key_node, deep=True)
-        if not isinstance(key, (str, int, float, bool)):
-            raise SceneError(_where(loader, key_node.start_mark), "", "keys must be plain names")
-        key = str(key)
-        result[key] = loader.construct_object(value_node, deep=True)
-        result.key_where[key] = _where(loader, key_node.start_mark)
-        result.value_where[key] = _where(loader, value_node.start_mark)
-    return result
-
-
-def _construct_seq(loader: _Loader, node: yaml.SequenceNode) -> SeqNode:
-    result = SeqNode(loader.construct_object(item, deep=True) for item in node.value)
-    result.where = _where(loader, node.start_mark)
-    result.item_where = [_where(loader, item.start_mark) for item in node.value]
-    return result
-
-
-_Loader.add_constructor("tag:yaml.org,2002:map", _construct_map)
-_Loader.add_constructor("tag:yaml.org,2002:seq", _construct_seq)
-
-
 def parse(text: str, display: str, folder: str = ".") -> MapNode:
     """Parse one YAML document whose top level must be a mapping."""
-    loader = _Loader(text)
-    loader.display, loader.folder = display, folder
+    loader = Loader(text)
     try:
-        tree = loader.get_single_data()
+        tree = Builder(loader, display, folder).document()
     except yaml.MarkedYAMLError as e:
-        mark = e.problem_mark or e.context_mark
-        where = Where(display, mark.line + 1, mark.column + 1) if mark else display
-        problem = e.problem or e.context
-        if mark and _char_at(text, mark.line, mark.column) == "\t":
-            problem = "tab characters cannot indent YAML (use spaces)"
-        raise SceneError(where, "", f"invalid YAML: {problem}") from None
+        raise _syntax_error(e, text, display) from None
+    except yaml.reader.ReaderError as e:
+        position = e.position
+        if not isinstance(loader, yaml.SafeLoader):     # libyaml counts bytes of UTF-8
+            position = len(text.encode("utf-8")[:position].decode("utf-8", errors="ignore"))
+        raise SceneError(_where_in(text, display, position), "", "invalid YAML: "
+                         f"{_character(e.character)} is not allowed (control characters cannot appear in YAML)"
+                         ) from None
     except yaml.YAMLError as e:
-        raise SceneError(display, "", f"invalid YAML: {e}") from None
-    except RecursionError:
-        raise SceneError(display, "", "invalid YAML: structure nested too deeply") from None
+        raise SceneError(display, "", f"invalid YAML: {' '.join(str(e).split())}") from None
     finally:
         loader.dispose()
     if tree is None:
-        tree = MapNode()
-        tree.where, tree.key_where, tree.value_where = Where(display, 1, 1), {}, {}
-        tree.folder, tree.duplicates = folder, []
+        return MapNode.empty(Where(display, 1, 1), folder)
     if not isinstance(tree, MapNode):
         raise SceneError(Where(display, 1, 1), "", "a scene must be a mapping of keys")
     return tree
+
+
+def _syntax_error(e: yaml.MarkedYAMLError, text: str, display: str) -> SceneError:
+    mark = e.problem_mark or e.context_mark
+    where = Where(display, mark.line + 1, mark.column + 1) if mark else display
+    problem = " ".join(str(e.problem or e.context).split())
+    if mark and _char_at(text, mark.line, mark.column) == "\t":
+        problem = "tab characters cannot indent YAML (use spaces)"
+    return SceneError(where, "", f"invalid YAML: {problem}")
+
+
+def _character(c) -> str:
+    code = ord(c) if isinstance(c, str) else int(c)
+    return f"the character U+{code:04X}"
+
+
+def _where_in(text: str, display: str, position: int) -> Where:
+    """Line and column of character `position` of `text`."""
+    line = text.count("\n", 0, position)
+    return Where(display, line + 1, position - (text.rfind("\n", 0, position) + 1) + 1)
 
 
 def _char_at(text: str, line: int, column: int) -> str:
@@ -121,45 +84,62 @@ def _char_at(text: str, line: int, column: int) -> str:
 
 
 def read_text(path: str, where=None, key: str = "") -> str:
-    """A file's text, or a SceneError saying why it cannot be read."""
+    """A scene file's text, or a SceneError saying why it cannot be read."""
     try:
-        with open(path, encoding="utf-8") as f:
-            return f.read()
+        data = read_bytes(path, MAX_SCENE_BYTES)
     except FileNotFoundError:
-        raise SceneError(where or path, key, f"file not found: {path}") from None
-    except IsADirectoryError:
-        raise SceneError(where or path, key, f"is a folder, not a file: {path}") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise SceneError(where or path, key, f"cannot read {path}: {e}") from None
+        raise SceneError(where or path, key, f"file not found: {shown(path)}") from None
+    except OSError as e:
+        raise SceneError(where or path, key, f"cannot read {shown(path)}: {e.strerror or e}") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        good = data[:e.start].decode("utf-8")
+        raise SceneError(_where_in(good, path, len(good)), "",
+                         f"not UTF-8 text (byte 0x{data[e.start]:02x})") from None
 
 
 def load(path: str) -> list[MapNode]:
-    """The scene file and its includes, included documents first (depth first)."""
+    """The scene file and its includes, included documents first (depth first), each file once."""
     docs: list[MapNode] = []
-    _load(path, None, "", (), docs)
+    _load(path, None, "", (), docs, set())
     return docs
 
 
-def _load(path: str, where, key: str, stack: tuple, docs: list) -> None:
+def _load(path: str, where, key: str, stack: tuple, docs: list, seen: set) -> None:
     real = os.path.realpath(path)
     if real in stack:
-        chain = " -> ".join(os.path.basename(p) for p in stack + (real,))
+        chain = " -> ".join(shown(os.path.basename(p)) for p in stack + (real,))
         raise SceneError(where, key, f"include cycle: {chain}")
+    if real in seen:
+        return                                  # included along another path already
+    if len(stack) > MAX_INCLUDE_DEPTH:
+        raise SceneError(where, key, f"includes nest more than {MAX_INCLUDE_DEPTH} deep")
+    seen.add(real)
     tree = parse(read_text(path, where, key), path, os.path.dirname(path) or ".")
+    for k, name, item_where in _includes(tree):
+        _load(os.path.normpath(os.path.join(tree.folder, name)), item_where, f"include[{k}]",
+              stack + (real,), docs, seen)
+    if stack:
+        for k in tree:
+            if k not in INCLUDABLE:
+                raise SceneError(tree.key_where[k], shown(k), "not allowed in an included file "
+                                 "(only materials, lights and objects are merged)")
+    docs.append(tree)
+
+
+def _includes(tree: MapNode):
+    """(k, file name, where) of each entry of the `include:` list."""
     includes = tree.get("include", [])
     if isinstance(includes, str):
-        includes = [includes]
+        return [(0, includes, tree.value_where["include"])]
     if not isinstance(includes, list):
         raise SceneError(tree.value_where["include"], "include", "must be a list of file names")
+    out = []
     for k, name in enumerate(includes):
         item_where = includes.item_where[k] if isinstance(includes, SeqNode) else tree.value_where["include"]
         if not isinstance(name, str):
             raise SceneError(item_where, f"include[{k}]", "must be a file name")
-        _load(os.path.normpath(os.path.join(tree.folder, name)), item_where, f"include[{k}]",
-              stack + (real,), docs)
-    if stack:
-        for k in tree:
-            if k not in INCLUDABLE:
-                raise SceneError(tree.key_where[k], k, "not allowed in an included file "
-                                 "(only materials, lights and objects are merged)")
-    docs.append(tree)
+        out.append((k, name, item_where))
+    return out
+

@@ -1,0 +1,58 @@
+"""Checks on output paths, made before any work: outputs never destroy anything.
+
+An output must name a regular file or nothing yet, in a folder that exists, with
+an extension the writer knows (writer.FORMATS); it must not be one of the run's
+inputs (the scene, an include, a mesh, a texture, a compared image), compared by
+real path and by inode so links and other spellings are caught; and two outputs
+of one run must differ.
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+
+from rtcli.errors import RtcliError, shown
+from rtcli.scenefile.files import kind_of
+from rtcli.writer import image_format
+
+
+def check_outputs(outputs: list[tuple[str, bool]], inputs: list[str]) -> None:
+    """Refuse before rendering: `outputs` are (path, is an id map), `inputs` the files read."""
+    seen: dict = {}
+    known = {_identity(p) for p in inputs} - {None}
+    reals = {os.path.realpath(p) for p in inputs}
+    for path, ids in outputs:
+        real = os.path.realpath(path)
+        if real in reals or _identity(path) in known:
+            raise RtcliError(f"{shown(path)}: is an input of this run; it will not be overwritten "
+                             "(choose another output name)")
+        _check_replaceable(path)
+        if not os.path.isdir(os.path.dirname(os.path.abspath(path))):
+            raise RtcliError(f"{shown(path)}: output folder does not exist")
+        image_format(path, ids)
+        if real in seen:
+            raise RtcliError(f"{shown(path)}: given for two outputs; they must differ")
+        seen[real] = path
+
+
+def _check_replaceable(path: str) -> None:
+    """An existing output must be a regular file: a folder, FIFO or device is never replaced."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return
+    except OSError as e:
+        raise RtcliError(f"{shown(path)}: cannot use as output: {e.strerror}") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise RtcliError(f"{shown(path)}: is {kind_of(st.st_mode)}, not a regular file; "
+                         "it will not be replaced")
+
+
+def _identity(path: str):
+    """(device, inode) of an existing file, or None."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino

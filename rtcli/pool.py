@@ -1,0 +1,79 @@
+"""Stopping the render's worker processes at once, and naming why one died.
+
+A render's tiles go to a pool of forked worker processes (render.py). Workers
+ignore SIGINT, so Ctrl-C in a terminal (sent to the whole process group) reaches
+only the parent, which then stops them all: pending tiles are cancelled and the
+workers killed, so the command ends within a moment instead of finishing every
+queued tile. A worker also dies with its parent (Linux's PR_SET_PDEATHSIG), so no
+worker outlives a parent that was killed outright.
+"""
+
+from __future__ import annotations
+
+import signal
+import time
+
+from rtcli.errors import Interrupted, RtcliError
+
+PR_SET_PDEATHSIG = 1
+
+
+def watch_worker() -> None:
+    """In a worker: ignore SIGINT (the parent handles it) and die when the parent dies."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        import ctypes
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+    except (OSError, AttributeError):            # not Linux: the parent's stop_pool still applies
+        pass
+
+
+def _processes(pool) -> list:
+    return list((getattr(pool, "_processes", None) or {}).values())
+
+
+def stop_pool(pool, finished: bool) -> None:
+    """Shut the pool down; unless every tile is done, cancel the rest and kill the workers first."""
+    if finished:
+        pool.shutdown(wait=True)
+        return
+    workers = _processes(pool)
+    for p in workers:
+        if p.exitcode is None:
+            p.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in workers:
+        p.join(timeout=5)
+
+
+def _exit_codes(workers: list, wait: float = 1.0) -> list[int]:
+    """The non-zero exit codes of the workers, waiting a moment for the one that died to be reaped.
+
+    The pool can learn of a death (a half-written result) a moment before the
+    kernel reports the dead process's status; the codes other than SIGTERM's are
+    the informative ones (the pool terminates the survivors with SIGTERM).
+    """
+    deadline = time.monotonic() + wait
+    while True:
+        codes = [p.exitcode for p in workers if p.exitcode not in (None, 0)]
+        if any(c != -signal.SIGTERM for c in codes) or time.monotonic() > deadline:
+            return codes
+        time.sleep(0.01)
+
+
+def worker_died(pool) -> BaseException:
+    """What to raise when a worker died mid-render: Interrupted when SIGTERM or SIGINT killed it
+    (the whole process group was signalled), else an RtcliError naming the signal or exit code."""
+    codes = _exit_codes(_processes(pool))
+    signals = [-c for c in codes if c < 0]
+    if signals and all(s in (signal.SIGTERM, signal.SIGINT) for s in signals):
+        return Interrupted(signals[0])
+    killer = next((s for s in signals if s not in (signal.SIGTERM, signal.SIGINT)), None)
+    if killer is not None:
+        hint = " (out of memory?)" if killer == signal.SIGKILL else ""
+        what = f"was killed by {signal.Signals(killer).name}{hint}"
+    elif codes:
+        what = f"exited with code {codes[0]}"
+    else:
+        what = "died unexpectedly (killed, or out of memory)"
+    return RtcliError(f"a worker process {what}; the render was stopped")

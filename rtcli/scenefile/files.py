@@ -1,0 +1,109 @@
+"""Opening the files a scene names: scene files, includes, meshes and textures.
+
+Every input is checked with os.stat before it is opened: only regular files are
+read (opening a FIFO would block, and a device such as /dev/zero never ends), and
+files larger than their documented limit (docs/scene-format.md, "Limits") are
+refused without being read. The real paths of the files a load reads are
+recorded, so the command line can refuse an output that would overwrite one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import os
+import stat
+import warnings
+
+from PIL import Image
+
+from rtcli.scenefile.limits import MAX_IMAGE_BYTES, MAX_TEXTURE_PIXELS, MB
+
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+          (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+          (stat.S_ISSOCK, "a socket"))
+
+_read: contextvars.ContextVar[list | None] = contextvars.ContextVar("rtcli_inputs", default=None)
+
+
+class InputError(OSError):
+    """A path that names no readable regular file of an allowed size; strerror says why
+    (without the path, as OSError's strerror)."""
+
+    def __init__(self, reason: str):
+        super().__init__(reason)
+        self.strerror = reason
+
+    def __str__(self) -> str:
+        return self.strerror
+
+
+def kind_of(mode: int) -> str:
+    """'a folder', 'a FIFO (named pipe)', ... for a file mode that is not a regular file."""
+    return next((name for test, name in _KINDS if test(mode)), "a special file")
+
+
+def check_input(path: str, limit: int) -> int:
+    """The size of the regular file at `path`; InputError (or FileNotFoundError) otherwise.
+
+    Uses os.stat, which never opens the file, so a FIFO or a device is refused
+    before anything could block on it or read it without end.
+    """
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise
+    except OSError as e:
+        raise InputError(e.strerror or str(e)) from None
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(f"not a regular file but {kind_of(st.st_mode)}")
+    if st.st_size > limit:
+        raise InputError(f"too large: {st.st_size / MB:.1f} MB, more than the {limit // MB} MB allowed")
+    _record(path)
+    return st.st_size
+
+
+def read_bytes(path: str, limit: int) -> bytes:
+    """The whole content of a checked regular file, never more than `limit` bytes."""
+    size = check_input(path, limit)
+    with open(path, "rb") as f:
+        data = f.read(size + 1)                   # read(n) reserves n bytes: ask for what stat said
+        if len(data) > size:
+            data += f.read(limit + 1 - len(data))
+    if len(data) > limit:
+        raise InputError(f"too large: it grew past the {limit // MB} MB allowed while being read")
+    return data
+
+
+def _record(path: str) -> None:
+    read = _read.get()
+    if read is not None:
+        read.append(os.path.realpath(path))
+
+
+@contextlib.contextmanager
+def recording_inputs():
+    """Collects the real path of every input checked inside the block, in a list."""
+    read: list[str] = []
+    token = _read.set(read)
+    try:
+        yield read
+    finally:
+        _read.reset(token)
+
+
+@contextlib.contextmanager
+def open_image(path: str):
+    """A texture opened by Pillow after the checks above; a decompression bomb (more than
+    MAX_TEXTURE_PIXELS texels, however small the file) is an InputError, not a warning."""
+    check_input(path, MAX_IMAGE_BYTES)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(path) as img:
+                w, h = img.size
+                if w * h > MAX_TEXTURE_PIXELS:
+                    raise InputError(f"{w}x{h} is {w * h:,} texels, more than the {MAX_TEXTURE_PIXELS:,} allowed")
+                yield img
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as e:
+        raise InputError(f"refused as a decompression bomb: {' '.join(str(e).split())}") from None

@@ -1,0 +1,231 @@
+"""YAML parser events -> a tree of MapNode/SeqNode, with the loading limits.
+
+The safe loader's parser (libyaml's when present) and its scalar rules, but
+no node graph: each value is built as its events arrive, without recursion.
+Mappings and lists nest at most MAX_DEPTH deep; aliases, each counted as a copy
+of what it names, repeat at most ALIAS_BUDGET values; an alias may not name a
+collection that contains it; merge keys (`<<`) merge as PyYAML's flatten_mapping
+does, without copying (docs/scene-format.md, "Limits").
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from array import array
+
+import yaml
+
+from rtcli.errors import SceneError, Where, quoted, shown
+from rtcli.scenefile.limits import ALIAS_BUDGET, MAX_DEPTH, RANGE
+from rtcli.scenefile.nodes import MapNode, SeqNode, pack, size_of, unpack
+
+_TAG = "tag:yaml.org,2002:"
+_SCALAR_TAGS = {_TAG + t for t in ("null", "bool", "int", "float", "str", "binary", "timestamp")}
+_PLAIN_FLOAT = re.compile(r"-?[0-9]+\.[0-9]*\Z")      # read as a float by every YAML 1.1 rule too
+_PLAIN_INT = re.compile(r"-?[1-9][0-9]{0,17}\Z|0\Z")
+_MERGE = object()               # the value of a `<<` key
+
+
+class Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
+    """The safe loader's parser and scalar rules (libyaml's parser when present); reads 1e-6 as a float."""
+
+
+Loader.add_implicit_resolver(        # YAML 1.1 wants a dot in 1.0e-6; people write 1e-6
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
+
+
+class _Frame:
+    """A mapping or list being read: the node and, for a mapping, its (key, value) events so far."""
+
+    __slots__ = ("node", "anchor", "pairs", "key", "key_pos", "places", "size")
+
+    def __init__(self, node, anchor, pos):
+        self.node, self.anchor, self.places, self.size = node, anchor, array("Q", [pos]), 1
+        self.pairs, self.key, self.key_pos = [], None, 0
+
+class Builder:
+    """Builds one document's MapNode/SeqNode tree from parser events, with the limits above."""
+
+    def __init__(self, loader: Loader, display: str, folder: str):
+        self.loader, self.file, self.folder = loader, display, folder
+        self.anchors: dict = {}            # name -> (value, where) of finished anchored values
+        self.open: set = set()             # anchors of collections still being read
+        self.budget = ALIAS_BUDGET
+
+    def where(self, mark) -> Where:
+        return Where(self.file, mark.line + 1, mark.column + 1)
+
+    def document(self):
+        """The single document's value; None for an empty stream."""
+        get, check = self.loader.get_event, self.loader.check_event
+        get()                                                   # stream start
+        if check(yaml.StreamEndEvent):
+            return None
+        get()                                                   # document start
+        value = self.value()
+        get()                                                   # document end
+        if not check(yaml.StreamEndEvent):
+            raise SceneError(self.where(get().start_mark), "", "invalid YAML: a scene is a single document "
+                             "(found a second one)")
+        return value
+
+    def value(self):
+        """The next complete value, read without recursion."""
+        stack: list[_Frame] = []
+        while True:
+            event = self.loader.get_event()
+            kind = type(event)
+            if kind is yaml.MappingStartEvent or kind is yaml.SequenceStartEvent:
+                stack.append(self.start(event, len(stack)))
+                continue
+            if kind is yaml.ScalarEvent:
+                value, pos = self.scalar(event), pack(event.start_mark)
+            elif kind is yaml.AliasEvent:
+                value, pos = self.alias(event), pack(event.start_mark)
+            else:                                               # mapping or sequence end
+                value = self.finish(stack.pop())
+                pos = value.places[0]
+            if not stack:
+                return value
+            self.add(stack[-1], value, pos)
+
+    def start(self, event, depth: int) -> _Frame:
+        if depth >= MAX_DEPTH:
+            raise SceneError(self.where(event.start_mark), "", f"values nest more than {MAX_DEPTH} deep")
+        if event.tag not in (None, "!", _TAG + "map", _TAG + "seq"):
+            raise SceneError(self.where(event.start_mark), "", f"invalid YAML: unsupported tag {quoted(event.tag)}")
+        if event.anchor is not None:
+            self.check_anchor(event)
+            self.open.add(event.anchor)
+        node = MapNode() if type(event) is yaml.MappingStartEvent else SeqNode()
+        return _Frame(node, event.anchor, pack(event.start_mark))
+
+    def check_anchor(self, event) -> None:
+        if event.anchor in self.anchors or event.anchor in self.open:
+            first = self.anchors.get(event.anchor, (None, None))[1]
+            at = f" (first given at line {first.line})" if first else ""
+            raise SceneError(self.where(event.start_mark), "", f"duplicate anchor &{shown(event.anchor)}{at}")
+
+    def scalar(self, event):
+        tag, text = event.tag, event.value
+        if tag is None or tag == "!":
+            if event.implicit[0] and _PLAIN_FLOAT.match(text):
+                value = float(text)
+                return self.anchored(event, value)
+            if event.implicit[0] and _PLAIN_INT.match(text):
+                return self.anchored(event, int(text))
+            tag = self.loader.resolve(yaml.ScalarNode, text, event.implicit)
+        if tag == _TAG + "str":
+            value = sys.intern(text) if len(text) <= 64 else text
+        elif tag == _TAG + "merge":
+            value = _MERGE
+        elif tag in _SCALAR_TAGS:
+            value = self.construct(tag, event)
+        else:
+            raise SceneError(self.where(event.start_mark), "", f"invalid YAML: unsupported tag {quoted(tag)}")
+        return self.anchored(event, value)
+
+    def construct(self, tag: str, event):
+        node = yaml.ScalarNode(tag, event.value, event.start_mark, event.end_mark, event.style)
+        try:
+            return self.loader.yaml_constructors[tag](self.loader, node)
+        except (ValueError, KeyError, TypeError, AttributeError):
+            digits = sum(c.isdigit() for c in event.value)
+            if digits > 300:            # past a float, or past Python's 4300-digit limit on int()
+                raise SceneError(self.where(event.start_mark), "", f"a number of {digits} digits is out of "
+                                 f"range (numbers must be {RANGE})") from None
+            raise SceneError(self.where(event.start_mark), "", f"invalid YAML: {quoted(event.value)} "
+                             f"is not a valid !!{tag.rsplit(':', 1)[-1]}") from None
+
+    def anchored(self, event, value):
+        if event.anchor is not None:
+            self.check_anchor(event)
+            self.anchors[event.anchor] = (value, self.where(event.start_mark))
+        return value
+
+    def alias(self, event):
+        name = event.anchor
+        if name in self.open:
+            raise SceneError(self.where(event.start_mark), "", f"alias *{shown(name)} names a collection "
+                             "that contains it (recursive values are not allowed)")
+        if name not in self.anchors:
+            raise SceneError(self.where(event.start_mark), "", f"invalid YAML: undefined alias *{shown(name)}")
+        value = self.anchors[name][0]
+        self.budget -= size_of(value)
+        if self.budget < 0:
+            raise SceneError(self.where(event.start_mark), "", f"aliases repeat more than {ALIAS_BUDGET:,} values "
+                             "(each alias counts as a copy of what it names)")
+        return value
+
+    def add(self, frame: _Frame, value, pos: int) -> None:
+        """Deliver a finished value, which starts at packed position `pos`, to the collection being read."""
+        node = frame.node
+        if type(node) is SeqNode:
+            node.append(value)
+            frame.places.append(pos)
+            frame.size += size_of(value)
+        elif frame.key is None:
+            frame.key, frame.key_pos = self.key(value, pos), pos
+        else:
+            frame.pairs.append((frame.key, frame.key_pos, value, pos))
+            frame.key = None
+
+    def key(self, value, pos: int):
+        if value is _MERGE:
+            return value
+        if not isinstance(value, (str, int, float, bool)):
+            raise SceneError(unpack(self.file, pos), "", "keys must be plain names")
+        return value if type(value) is str else sys.intern(str(value))
+
+    def finish(self, frame: _Frame):
+        node = frame.node
+        node.file, node.size = self.file, frame.size
+        if type(node) is MapNode:
+            node.folder, node._index = self.folder, None
+            self.fill_map(node, frame)
+        else:
+            node.places = frame.places
+        if frame.anchor is not None:
+            self.open.discard(frame.anchor)
+            self.anchors[frame.anchor] = (node, node.where)
+        return node
+
+    def fill_map(self, node: MapNode, frame: _Frame) -> None:
+        """Merged entries first (as PyYAML's flatten_mapping orders them), then the written ones, which win."""
+        places, merged, written, first, duplicates = frame.places, [], [], {}, []
+        for key, key_pos, value, value_pos in frame.pairs:
+            if key is _MERGE:
+                merged.extend(self.merge_entries(value, value_pos))
+                continue
+            if key in first:
+                duplicates.append((key, unpack(self.file, key_pos), unpack(self.file, first[key])))
+            first.setdefault(key, key_pos)
+            written.append((key, key_pos, value, value_pos))
+        slot = {}                                               # key -> its index in places
+        for key, key_pos, value, value_pos in merged + written:
+            if key in slot:
+                k = slot[key]
+                node.size -= size_of(node[key])
+                places[k], places[k + 1] = key_pos, value_pos
+            else:
+                slot[key] = len(places)
+                places.extend((key_pos, value_pos))
+            node[key] = value
+            node.size += size_of(value)
+        node.places, node.duplicates = places, tuple(duplicates)
+
+    def merge_entries(self, value, value_pos) -> list:
+        """(key, key_pos, value, value_pos) of the mappings a `<<` key names, the first listed winning."""
+        sources = [value] if isinstance(value, MapNode) else value
+        if not isinstance(sources, list) or not all(isinstance(s, MapNode) for s in sources):
+            raise SceneError(unpack(self.file, value_pos), "", "invalid YAML: a merge key (<<) takes a mapping "
+                             "or a list of mappings")
+        entries = []
+        for source in reversed(sources):
+            for k, key in enumerate(source):
+                entries.append((key, source.places[1 + 2 * k], source[key], source.places[2 + 2 * k]))
+        return entries

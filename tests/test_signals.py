@@ -1,0 +1,114 @@
+"""Signals and dying workers, on a real multi-worker render in a subprocess.
+
+Each test starts `rtcli render` in a session of its own (so its process group can
+be signalled as a terminal's Ctrl-C would), waits until the workers are busy,
+sends a signal and checks: the exit code, the time to exit (a generous bound:
+the machine is shared), one error line, no output or temporary file, and no
+process left in the group or with the render as parent.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+pytestmark = pytest.mark.skipif(not os.path.exists("/proc/self/task"), reason="needs Linux's /proc")
+
+SLOW = """\
+image: {width: 320, height: 240}
+camera: {eye: [0, 2, 8], look_at: [0, 0, 0], fov: 50}
+render: {samples: 8, max_depth: 6}
+lights: [{position: [5, 8, 5], area: {u: [1, 0, 0], v: [0, 0, 1], samples: 4}}]
+objects:
+  - {plane: {}, material: {reflection: 0.5}}
+  - {sphere: {center: [-1.5, 1, 0]}, material: {reflection: 0.8}}
+  - {sphere: {center: [1.5, 1, 0]}, material: {transmission: 0.9, ior: 1.5}}
+  - {torus: {major: 1, minor: 0.3}, transform: [{translate: [0, 1, -2]}]}
+"""                                      # about 50 s on two cores with --engine numpy
+
+
+def _children(pid: int) -> list[int]:
+    with open(f"/proc/{pid}/task/{pid}/children") as f:
+        return [int(x) for x in f.read().split()]
+
+
+def _group_members(pgid: int) -> list[int]:
+    """Processes whose process group is pgid, or whose parent is pgid."""
+    found = []
+    for name in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{name}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if int(fields[1]) == pgid or int(fields[2]) == pgid:          # ppid, pgrp
+            found.append(int(name))
+    return found
+
+
+def _start(tmp_path, workers: int) -> subprocess.Popen:
+    (tmp_path / "slow.yaml").write_text(SLOW)
+    proc = subprocess.Popen([sys.executable, "-m", "rtcli", "render", "slow.yaml", "--engine", "numpy",
+                             "--workers", str(workers), "-o", "out.png"],
+                            cwd=tmp_path, stderr=subprocess.PIPE, start_new_session=True)
+    deadline = time.monotonic() + 30
+    while len(_children(proc.pid)) < workers - (workers == 1) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(1.0)                      # the scene is loaded and tiles are being traced
+    assert proc.poll() is None, proc.stderr.read()
+    return proc
+
+
+def _stop(proc, send) -> tuple[int, float, str]:
+    start = time.monotonic()
+    send()
+    try:
+        _, err = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)           # leave nothing running when the test fails
+        proc.wait()
+        raise
+    return proc.returncode, time.monotonic() - start, err.decode()
+
+
+def _nothing_left(tmp_path, proc) -> None:
+    time.sleep(0.2)
+    assert _group_members(proc.pid) == []
+    assert sorted(os.listdir(tmp_path)) == ["slow.yaml"]
+
+
+@pytest.mark.parametrize("target, signum, code", [
+    ("group", signal.SIGINT, 130),       # Ctrl-C in a terminal
+    ("parent", signal.SIGINT, 130),
+    ("group", signal.SIGTERM, 143),
+    ("parent", signal.SIGTERM, 143),
+])
+def test_signal_stops_a_multi_worker_render_at_once(tmp_path, target, signum, code):
+    proc = _start(tmp_path, workers=2)
+    send = (lambda: os.killpg(proc.pid, signum)) if target == "group" else (lambda: os.kill(proc.pid, signum))
+    returncode, seconds, err = _stop(proc, send)
+    assert (returncode, err) == (code, "error: interrupted\n")
+    assert seconds < 10
+    _nothing_left(tmp_path, proc)
+
+
+def test_signal_stops_a_single_worker_render(tmp_path):
+    proc = _start(tmp_path, workers=1)
+    returncode, seconds, err = _stop(proc, lambda: os.killpg(proc.pid, signal.SIGINT))
+    assert (returncode, err, seconds < 10) == (130, "error: interrupted\n", True)
+    _nothing_left(tmp_path, proc)
+
+
+def test_a_killed_worker_ends_the_render_with_one_line(tmp_path):
+    """A worker killed as the out-of-memory killer would: exit 2, one line naming it, no traceback."""
+    proc = _start(tmp_path, workers=2)
+    worker = _children(proc.pid)[0]
+    returncode, seconds, err = _stop(proc, lambda: os.kill(worker, signal.SIGKILL))
+    assert returncode == 2 and seconds < 10
+    assert err == "error: a worker process was killed by SIGKILL (out of memory?); the render was stopped\n"
+    _nothing_left(tmp_path, proc)
