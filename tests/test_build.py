@@ -152,8 +152,9 @@ GEOMETRY = {
                            "scene.yaml:3:26: objects[0].triangle.vertices: "
                            "degenerate triangle (its vertices are collinear)"),
     #          "  - polygon: {vertices: [[...": '[' at 25
-    "zero_area_polygon": (obj("polygon: {vertices: [[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]]}"),
-                          "scene.yaml:3:25: objects[0].polygon.vertices: degenerate polygon (zero area)"),
+    "collinear_polygon": (obj("polygon: {vertices: [[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]]}"),
+                          "scene.yaml:3:25: objects[0].polygon.vertices: "
+                          "degenerate polygon (its vertices lie on one line)"),
     "non_coplanar_polygon": (obj("polygon: {vertices: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 1]]}"),
                              "scene.yaml:3:25: objects[0].polygon.vertices: "
                              "polygon vertices are not coplanar"),

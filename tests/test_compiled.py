@@ -255,6 +255,22 @@ def test_image_textures_on_every_shape(yaml_scene, tmp_path):
     assert len(np.unique(b.reshape(-1, 3), axis=0)) > 2000
 
 
+def test_texels_are_kept_as_bytes(yaml_scene, tmp_path):
+    """A picture costs 3 bytes a texel, read as byte / 255; a scene's only picture is not copied."""
+    from PIL import Image
+    picture = np.random.default_rng(3).integers(0, 256, (40, 30, 3), dtype=np.uint8)
+    Image.fromarray(picture).save(tmp_path / "p.png")
+    scene = yaml_scene("""
+        camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}
+        objects: [{square: {}, material: {texture: {image: p.png, repeat: false}}}]
+        """)
+    texels = scene.materials.texels
+    assert texels.dtype == np.uint8 and texels.shape == (1200, 3) and np.array_equal(texels.reshape(40, 30, 3), picture)
+    assert np.shares_memory(texels, scene.materials.materials[1].texture.texels)
+    a, b, _, _ = both(scene, 64, 48)
+    assert np.array_equal(a, b) and len(np.unique(a.reshape(-1, 3), axis=0)) > 100
+
+
 @pytest.mark.parametrize("order", ["floor first", "floor last"])
 def test_ties_with_the_floor_go_to_the_same_object(yaml_scene, order):
     """A glass cylinder's base cap and a polygon lie on the floor plane: coplanar surfaces, hit at

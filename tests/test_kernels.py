@@ -293,7 +293,7 @@ def core_cases():
                               np.array([0.0, -1, 0]), 0.7, 3.0, np.array([1.0, 0, 0]), np.array([0, 0, 0.5]), 3).row
     cam = camera.from_fov([0, 1, 5], [0, 0, 0], [0, 1, 0], 40, 64, 48).row
     checker = textures.texture_row(textures.Checker(np.array([1.0, 0.5, 0]), np.array([0, 0.2, 1.0]), 0.3))
-    texels = rng.uniform(0, 1, (35, 3))
+    texels = rng.integers(0, 256, (35, 3), dtype=np.uint8)
     image = textures.texture_row(textures.ImageTexture(texels.reshape(7, 5, 3), True))
     clamped = textures.texture_row(textures.ImageTexture(texels.reshape(7, 5, 3), False))
     ij = rng.integers(0, 4000, (2, n))

@@ -53,11 +53,13 @@ class MaterialTable:
 
 
 def _texture_rows(materials) -> tuple[np.ndarray, np.ndarray]:
-    """(M, 12) texture rows and the (N, 3) texels of all image textures, one after another."""
-    rows, texels, first = [], [np.zeros((0, 3))], 0
+    """(M, 12) texture rows and the (N, 3) texels (uint8) of all image textures, one after
+    another; one picture's own texels, not a copy, when the scene has only one."""
+    rows, texels, first = [], [], 0
     for m in materials:
         rows.append(texture_row(m.texture, first))
         if isinstance(m.texture, ImageTexture):
-            texels.append(m.texture.texels.reshape(-1, 3))
+            texels.append(np.ascontiguousarray(m.texture.texels, dtype=np.uint8).reshape(-1, 3))
             first += len(texels[-1])
-    return np.array(rows).reshape(-1, 12), np.ascontiguousarray(np.concatenate(texels), dtype=float)
+    joined = texels[0] if len(texels) == 1 else np.concatenate(texels or [np.zeros((0, 3), np.uint8)])
+    return np.array(rows).reshape(-1, 12), joined

@@ -3,7 +3,8 @@
 For the kernels a material's texture is a row of floats (`texture_row`): its kind,
 then a checker's 1/size and two colors, or an image's place in a texel array
 (first texel, width, height) and whether it repeats. Texels are one (N, 3) array
-of floats, an image's rows one after another from its top row.
+of bytes, an image's rows one after another from its top row: 3 bytes a texel, so
+a 10000 x 10000 picture takes 300 MB; each is read as byte / 255.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ class ImageTexture:
     values are used as stored (byte / 255), like every other color of the scene.
     """
 
-    texels: np.ndarray      # (h, w, 3) float, row 0 at the top
+    texels: np.ndarray      # (h, w, 3) uint8, row 0 at the top
     repeat: bool = True
 
 
@@ -78,8 +79,8 @@ def wrap(k, n, repeat):
 @kernel
 def bilinear(texels, top, bottom, xa, xb, fx, fy, channel):
     """One channel between four texels: columns xa, xb of the rows starting at `top`, `bottom`."""
-    upper = texels[top + xa, channel] * (1 - fx) + texels[top + xb, channel] * fx
-    lower = texels[bottom + xa, channel] * (1 - fx) + texels[bottom + xb, channel] * fx
+    upper = texels[top + xa, channel] / 255.0 * (1 - fx) + texels[top + xb, channel] / 255.0 * fx
+    lower = texels[bottom + xa, channel] / 255.0 * (1 - fx) + texels[bottom + xb, channel] / 255.0 * fx
     return upper * (1 - fy) + lower * fy
 
 

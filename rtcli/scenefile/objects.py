@@ -84,7 +84,7 @@ def load_texels(p: Params, key: str) -> np.ndarray:
     path = os.path.join(p.folder, p.string(key))
     try:
         with open_image(path) as img:
-            return np.asarray(img.convert("RGB"), dtype=float) / 255.0
+            return np.ascontiguousarray(img.convert("RGB"), dtype=np.uint8)
     except FileNotFoundError:
         raise p.error(key, f"file not found: {shown(path)}") from None
     except (UnidentifiedImageError, OSError) as e:

@@ -1,8 +1,11 @@
 """Planar polygon p1 ... pk, convex or not, inside by the even-odd rule (notes 000 11.3.2).
 
-YAML: `polygon: {vertices: [p1, p2, ...]}` (at least 3, coplanar). The outward
-normal follows the vertex order by the right-hand rule (Newell's normal). (u, v)
-are planar coordinates in the polygon's plane, from its first vertex.
+YAML: `polygon: {vertices: [p1, p2, ...]}` (at least 3, coplanar, not all on one
+line). The outward normal follows the vertex order by the right-hand rule (Newell's
+normal). A polygon that crosses itself, a bow tie, is filled by the even-odd rule
+like any other; when its loops cancel Newell's normal, the plane's normal is the
+largest cross product of two edges from the first vertex. (u, v) are planar
+coordinates in the polygon's plane, from its first vertex.
 """
 
 from __future__ import annotations
@@ -56,10 +59,10 @@ class Polygon(Shape):
     def __init__(self, vertices):
         self.v = np.asarray(vertices, dtype=float)
         scale = max(np.ptp(self.v, axis=0).max(), 1e-300)
-        newell = np.sum(cross3(self.v, np.roll(self.v, -1, axis=0)), axis=0)   # 2 x area x normal
-        if np.linalg.norm(newell) <= 1e-12 * scale * scale:
-            raise ParamError("vertices", "degenerate polygon (zero area)")
-        self.n = unit3(newell)
+        normal = _plane_normal(self.v)
+        if np.linalg.norm(normal) <= 1e-12 * scale * scale:
+            raise ParamError("vertices", "degenerate polygon (its vertices lie on one line)")
+        self.n = unit3(normal)
         if np.abs(dot3(self.v - self.v[0], self.n)).max() > 1e-6 * scale:
             raise ParamError("vertices", "polygon vertices are not coplanar")
         self.axes = [k for k in range(3) if k != int(np.argmax(np.abs(self.n)))]
@@ -75,4 +78,17 @@ class Polygon(Shape):
     def examples(cls) -> list:
         star = np.radians(90 + 144 * np.arange(5))               # the pentagram {5/2}: crosses itself
         return [cls([[0, 0, 1], [2, 0, 1], [2, 1, 1], [1, 1, 1], [1, 2, 1], [0, 2, 1]]),
-                cls(np.stack([np.cos(star), np.sin(star), 0.3 * np.cos(star)], axis=1))]
+                cls(np.stack([np.cos(star), np.sin(star), 0.3 * np.cos(star)], axis=1)),
+                cls([[0, 0, 0], [2, 1, 0.5], [2, 0, 0.5], [0, 1, 0]])]            # a bow tie
+
+
+def _plane_normal(v: np.ndarray) -> np.ndarray:
+    """Newell's normal (2 x area x normal), or where a self-crossing polygon's loops cancel it,
+    the largest cross product of two edges from the first vertex (zero: all on one line)."""
+    scale = max(np.ptp(v, axis=0).max(), 1e-300)
+    newell = np.sum(cross3(v, np.roll(v, -1, axis=0)), axis=0)
+    if np.linalg.norm(newell) > 1e-6 * scale * scale:
+        return newell
+    edges = v[1:] - v[0]
+    crosses = cross3(edges[:, None], edges[None, :]).reshape(-1, 3)
+    return crosses[np.argmax(np.linalg.norm(crosses, axis=1))]
