@@ -97,6 +97,7 @@ def open_image(path: str):
     """A texture opened by Pillow after the checks above; a decompression bomb (more than
     MAX_TEXTURE_PIXELS texels, however small the file) is an InputError, not a warning."""
     check_input(path, MAX_IMAGE_BYTES)
+    threshold, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, MAX_TEXTURE_PIXELS     # Pillow warns above it
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
@@ -107,3 +108,5 @@ def open_image(path: str):
                 yield img
     except (Image.DecompressionBombError, Image.DecompressionBombWarning) as e:
         raise InputError(f"refused as a decompression bomb: {' '.join(str(e).split())}") from None
+    finally:
+        Image.MAX_IMAGE_PIXELS = threshold

@@ -10,7 +10,7 @@ MB = 1024 * 1024
 MAX_SCENE_BYTES = 64 * MB          # a scene file or an included file
 MAX_MESH_BYTES = 256 * MB          # an OBJ file
 MAX_IMAGE_BYTES = 256 * MB         # a texture image file
-MAX_TEXTURE_PIXELS = 89_478_485    # texels of a texture (Pillow's decompression-bomb threshold)
+MAX_TEXTURE_PIXELS = 1 << 27       # texels of a texture: 134,217,728 (16384 x 8192), 3 bytes each
 
 # YAML
 MAX_DEPTH = 200                    # mappings and lists inside one another

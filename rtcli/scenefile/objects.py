@@ -81,10 +81,18 @@ def texture_from(p: Params):
 
 
 def load_texels(p: Params, key: str) -> np.ndarray:
+    """The picture's texels (h, w, 3) as bytes, copied out of Pillow in bands of rows, so that
+    loading holds Pillow's decoded image and one more byte array, not a float copy."""
     path = os.path.join(p.folder, p.string(key))
     try:
         with open_image(path) as img:
-            return np.ascontiguousarray(img.convert("RGB"), dtype=np.uint8)
+            rgb = img if img.mode == "RGB" else img.convert("RGB")
+            w, h = rgb.size
+            texels = np.empty((h, w, 3), dtype=np.uint8)
+            band = max(1, (1 << 22) // max(w, 1))                     # about 12 MB a band
+            for y in range(0, h, band):
+                texels[y:y + band] = np.asarray(rgb.crop((0, y, w, min(h, y + band))))
+            return texels
     except FileNotFoundError:
         raise p.error(key, f"file not found: {shown(path)}") from None
     except (UnidentifiedImageError, OSError) as e:
