@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.compiled.pack import KIND, MATERIAL, TRANSFORMED, XFORM
+from rtcli.compiled.pack import KIND, MATERIAL, XFORM
 from rtcli.compiled.query import NORMALS_ANY, UV_ANY, scene_hit
 from rtcli.core.camera import primary_ray
 from rtcli.core.lights import COLOR, sample_point, toward, weight
@@ -42,14 +42,14 @@ SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.St
 def surface(g, k, prim, t, ox, oy, oz, dx, dy, dz):
     """The unit outward shading and geometric normals at the hit (world space, by A^-T), and the
     object-space hit point."""
-    row = g.objects[k]
-    if g.ints[k, TRANSFORMED]:
-        ox, oy, oz, dx, dy, dz = ray_to_object(row, XFORM, ox, oy, oz, dx, dy, dz)
+    x = g.ints[k, XFORM]
+    if x >= 0:
+        ox, oy, oz, dx, dy, dz = ray_to_object(g.transforms[x], 0, ox, oy, oz, dx, dy, dz)
     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
-    nx, ny, nz, gx, gy, gz = NORMALS_ANY(g.ints[k, KIND], row, g.pool, prim, px, py, pz)
-    if g.ints[k, TRANSFORMED]:
-        nx, ny, nz = normal_to_world(row, XFORM, nx, ny, nz)
-        gx, gy, gz = normal_to_world(row, XFORM, gx, gy, gz)
+    nx, ny, nz, gx, gy, gz = NORMALS_ANY(g.ints[k, KIND], g.objects[k], g.pool, prim, px, py, pz)
+    if x >= 0:
+        nx, ny, nz = normal_to_world(g.transforms[x], 0, nx, ny, nz)
+        gx, gy, gz = normal_to_world(g.transforms[x], 0, gx, gy, gz)
     nx, ny, nz = unit(nx, ny, nz)
     gx, gy, gz = unit(gx, gy, gz)
     return nx, ny, nz, gx, gy, gz, px, py, pz

@@ -5,10 +5,11 @@ any transform; checker and image textures; point, spot and area lights. A CSG ha
 kernels and keeps the numpy engine: `unsupported(scene)` names it.
 
 Geometry (`Geometry`), one row per scene object:
-- `objects` (N, OBJECT_WIDTH): the shape's row (rtcli/shapes/, its own layout) from
-  column SHAPE, then its packed transform (rtcli/core/transform.py) from XFORM;
-- `ints` (N, 4), by the names KIND (the shape's place in the registry), TRANSFORMED,
-  CASTS (its material casts shadows) and MATERIAL;
+- `objects` (N, SHAPE_WIDTH): the shape's row (rtcli/shapes/, its own layout);
+- `ints` (N, 4), by the names KIND (the shape's place in the registry), XFORM (its
+  row of `transforms`, -1 for none), CASTS (its material casts shadows) and MATERIAL;
+- `transforms` (T, 36): the packed transforms (rtcli/core/transform.py) of the
+  objects that have one, so that a scene of a million plain spheres pays nothing;
 - `listed`: the objects tested one by one: the unbounded ones (planes), or, as the
   numpy engine does for a scene without a BVH (Scene.wants_bvh: fewer than 8
   bounded objects, or --no-bvh), every object in file order, so that ties go the
@@ -30,17 +31,17 @@ from collections import namedtuple
 import numpy as np
 
 from rtcli.core.bvh import BVH
+from rtcli.core.scene import object_tree
 from rtcli.core.transform import PACKED
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import POOL_WIDTH
 
-SHAPE, XFORM = 0, 24                               # columns of an object row: the shape's row, its transform
-OBJECT_WIDTH = XFORM + PACKED
-KIND, TRANSFORMED, CASTS, MATERIAL = range(4)      # columns of ints
+SHAPE_WIDTH = 20                                   # columns of an object row: the widest shape's row
+KIND, XFORM, CASTS, MATERIAL = range(4)            # columns of ints
 KINDS = {cls: k for k, cls in enumerate(SHAPES.values())}
 
 # Few arrays on purpose: numba passes each array argument as several machine words.
-Geometry = namedtuple("Geometry", "objects ints listed nodes links perm pool")
+Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool")
 Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear texture texels "
                             "lights samples ambient background offset max_depth blinn")
 
@@ -78,17 +79,16 @@ class _Trees:
                 np.concatenate(self.perm).astype(np.int64))
 
 
-def geometry(scene, tree: bool) -> tuple[Geometry, int]:
+def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int]:
     """The scene's geometry, and the traversal stack it needs (the scene's tree, then a mesh's).
-    Without `tree` every object is listed, in file order."""
+    Without `tree` every object is listed, in file order; `bvh`: object_tree's, if made already."""
     n = len(scene.objects)
-    objects, ints = np.zeros((n, OBJECT_WIDTH)), np.zeros((n, 4), dtype=np.int64)
-    boxes = scene.boxes
-    listed = [k for k, b in enumerate(boxes) if b is None or not tree]
-    members = np.array([k for k, b in enumerate(boxes) if b is not None and tree], dtype=np.int64)
-    trees, mesh_depth = _Trees(), 0
-    scene_bvh = BVH(np.array([boxes[k][0] for k in members]).reshape(-1, 3),
-                    np.array([boxes[k][1] for k in members]).reshape(-1, 3), leaf_size=2)
+    objects, ints = np.zeros((n, SHAPE_WIDTH)), np.zeros((n, 4), dtype=np.int64)
+    bounded = scene.boxes.bounded
+    listed = np.flatnonzero(~bounded | (not tree))
+    members, scene_bvh = (bvh or object_tree(scene)) if tree else (np.zeros(0, np.int64), BVH(np.zeros((0, 3)),
+                                                                                             np.zeros((0, 3))))
+    trees, mesh_depth, transforms = _Trees(), 0, []
     trees.add(scene_bvh, members)                    # root 0
     pool, n_pool = [np.zeros((0, POOL_WIDTH))], 0
     for k, o in enumerate(scene.objects):
@@ -99,24 +99,26 @@ def geometry(scene, tree: bool) -> tuple[Geometry, int]:
         if shape.ROOT_COLUMN is not None:
             row[shape.ROOT_COLUMN] = trees.add(shape.bvh, np.arange(len(shape.pool)) + n_pool)
             mesh_depth = max(mesh_depth, shape.bvh.depth)
-        if len(row) > XFORM:
-            raise ValueError(f"a {type(shape).__name__} row is wider than {XFORM} columns")
-        objects[k, SHAPE:SHAPE + len(row)] = row
-        pool.append(shape.pool)
-        n_pool += len(shape.pool)
+        if len(row) > SHAPE_WIDTH:
+            raise ValueError(f"a {type(shape).__name__} row is wider than {SHAPE_WIDTH} columns")
+        objects[k, :len(row)] = row
+        if len(shape.pool):
+            pool.append(shape.pool)
+            n_pool += len(shape.pool)
         if o.transform is not None:
-            objects[k, XFORM:] = o.transform
-        ints[k] = KINDS[type(shape)], o.transform is not None, scene.materials.shadow[o.material], o.material
-    geo = Geometry(objects, ints, np.array(listed, dtype=np.int64), *trees.arrays(),
-                   np.ascontiguousarray(np.concatenate(pool)))
+            transforms.append(o.transform)
+        ints[k] = KINDS[type(shape)], len(transforms) - 1 if o.transform is not None else -1, \
+            scene.materials.shadow[o.material], o.material
+    geo = Geometry(objects, ints, np.array(transforms).reshape(-1, PACKED), listed.astype(np.int64),
+                   *trees.arrays(), np.ascontiguousarray(np.concatenate(pool)))
     return geo, scene_bvh.depth + mesh_depth + 4
 
 
 def mesh_geometry(mesh) -> Geometry:
     """One mesh's faces and tree (root 0) as a Geometry, for the compiled walk over its triangles."""
     none = np.zeros(0, dtype=np.int64)
-    return Geometry(np.zeros((0, OBJECT_WIDTH)), np.zeros((0, 4), dtype=np.int64), none, mesh.bvh.nodes,
-                    mesh.bvh.links, mesh.bvh.perm, np.ascontiguousarray(mesh.pool))
+    return Geometry(np.zeros((0, SHAPE_WIDTH)), np.zeros((0, 4), dtype=np.int64), np.zeros((0, PACKED)), none,
+                    mesh.bvh.nodes, mesh.bvh.links, mesh.bvh.perm, np.ascontiguousarray(mesh.pool))
 
 
 def looks(scene) -> Looks:

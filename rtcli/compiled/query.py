@@ -16,7 +16,7 @@ when numba is installed.
 
 from __future__ import annotations
 
-from rtcli.compiled.pack import CASTS, KIND, TRANSFORMED, XFORM
+from rtcli.compiled.pack import CASTS, KIND, XFORM
 from rtcli.core.bvh import walk, walk_rays
 from rtcli.core.transform import ray_to_object
 from rtcli.shapes import SHAPES
@@ -90,10 +90,10 @@ HIT_ANY, NORMALS_ANY, UV_ANY = chain("hit", no_hit), chain("normals", no_normals
 def object_hit(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
     """(t, prim) of scene object k for a world-space ray: the ray taken into object space
     (notes 000 11.3.4), then its shape's hit."""
-    row = g.objects[k]
-    if g.ints[k, TRANSFORMED]:
-        ox, oy, oz, dx, dy, dz = ray_to_object(row, XFORM, ox, oy, oz, dx, dy, dz)
-    return HIT_ANY(g.ints[k, KIND], row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)
+    x = g.ints[k, XFORM]
+    if x >= 0:
+        ox, oy, oz, dx, dy, dz = ray_to_object(g.transforms[x], 0, ox, oy, oz, dx, dy, dz)
+    return HIT_ANY(g.ints[k, KIND], g.objects[k], g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)
 
 
 @per_ray(inline=True)

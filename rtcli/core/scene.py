@@ -1,4 +1,8 @@
-"""The scene model: plain data built by rtcli/scenefile/, read by both engines. Picklable."""
+"""The scene model: plain data built by rtcli/scenefile/, read by both engines. Picklable.
+
+A scene may hold a million objects, so per object it keeps little: a slotted
+SceneObject, its shape, and a row of the arrays below.
+"""
 
 from __future__ import annotations
 
@@ -7,13 +11,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli.core.bvh import padded
+from rtcli.core.bvh import BVH, PAD
 from rtcli.core.materials import MaterialTable
 from rtcli.core.transform import Transform, outer_bounds
 
 BVH_MIN_OBJECTS = 8        # from this many bounded objects on, a BVH over them pays (both engines)
 
-@dataclass
+@dataclass(slots=True)
 class SceneObject:
     id: int                          # 1, 2, 3 ... in file order (signature ids)
     name: str
@@ -21,15 +25,40 @@ class SceneObject:
     material: int                    # row of the scene's MaterialTable
     world_from_object: Transform | None = None     # None: object space is world space
     kind: str = ""                   # the YAML shape name, for legends
+    transform: np.ndarray | None = field(init=False, repr=False)   # packed for the kernels (core/transform.py)
 
-    @functools.cached_property
-    def transform(self) -> np.ndarray | None:
-        """The packed transform the kernels read (rtcli.core.transform), None without one."""
-        return None if self.world_from_object is None else self.world_from_object.packed
+    def __post_init__(self):
+        self.transform = None if self.world_from_object is None else self.world_from_object.packed
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray] | None:
         """World-space box, or None when unbounded."""
         return outer_bounds(self.world_from_object, self.shape.bounds())
+
+
+class Boxes:
+    """The objects' world-space boxes, padded like the BVH's nodes (core/bvh.py): boxes[k] is
+    (lo, hi), or None for an unbounded object (a plane). Kept as two (N, 3) arrays."""
+
+    def __init__(self, objects: list):
+        n = len(objects)
+        self.lo, self.hi = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
+        for k, o in enumerate(objects):
+            box = o.bounds()
+            if box is not None:
+                self.lo[k], self.hi[k] = box
+        self.bounded = ~np.isnan(self.lo[:, 0])
+        pad = PAD * np.maximum(np.abs(self.lo).max(axis=1), np.abs(self.hi).max(axis=1))
+        pad = np.maximum(np.nan_to_num(pad), np.finfo(float).tiny)[:, None]
+        self.lo, self.hi = self.lo - pad, self.hi + pad
+
+    def __len__(self) -> int:
+        return len(self.bounded)
+
+    def __getitem__(self, k: int):
+        return (self.lo[k], self.hi[k]) if self.bounded[k] else None
+
+    def __iter__(self):
+        return (self[k] for k in range(len(self)))
 
 
 @dataclass
@@ -55,22 +84,22 @@ class Scene:
     accel: object = None             # the numpy engine's rtcli.wavefront.accel.Accelerator, when built
 
     @functools.cached_property
-    def boxes(self) -> list:
+    def boxes(self) -> Boxes:
         """Each object's world-space box (lo, hi), padded as the BVH's, or None when unbounded."""
-        return [None if b is None else padded(*b) for b in (o.bounds() for o in self.objects)]
+        return Boxes(self.objects)
 
     @functools.cached_property
     def wants_bvh(self) -> bool:
         """Whether the scene has enough bounded objects for a BVH over them to pay. Both engines
         decide alike, so that ties between objects go the same way."""
-        return sum(b is not None for b in self.boxes) >= BVH_MIN_OBJECTS
+        return int(self.boxes.bounded.sum()) >= BVH_MIN_OBJECTS
 
     @functools.cached_property
     def size(self) -> float:
         """A length for the scene's scale: the diagonal of its bounded objects and the eye."""
-        boxes = [b for b in self.boxes if b is not None]
-        lo = np.min([self.eye] + [b[0] for b in boxes], axis=0)
-        hi = np.max([self.eye] + [b[1] for b in boxes], axis=0)
+        b = self.boxes
+        lo = np.min(np.vstack([self.eye, b.lo[b.bounded]]), axis=0)
+        hi = np.max(np.vstack([self.eye, b.hi[b.bounded]]), axis=0)
         return max(float(np.linalg.norm(hi - lo)), 1e-3)
 
     @property
@@ -82,3 +111,11 @@ class Scene:
     def light_rows(self) -> np.ndarray:
         """(L, 22) the lights as the kernels read them (rtcli.core.lights)."""
         return np.array([light.row for light in self.lights]).reshape(-1, 22)
+
+
+def object_tree(scene: Scene) -> tuple[np.ndarray, BVH]:
+    """(members, BVH): the scene's bounded objects and a BVH over their world boxes, as both
+    engines walk it."""
+    boxes = scene.boxes
+    members = np.flatnonzero(boxes.bounded)
+    return members, BVH(boxes.lo[members], boxes.hi[members], leaf_size=2)

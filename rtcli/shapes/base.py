@@ -71,6 +71,8 @@ class ParamError(ValueError):
 class Shape:
     """Base of the shapes; see the module docstring."""
 
+    __slots__ = ()                       # a shape may keep its state in slots (a sphere: its row)
+
     params: tuple = ()
     kernels: ShapeKernels
     SPANS = 1                            # intervals per ray that spans() returns

@@ -87,10 +87,19 @@ class Sphere(Shape):
     params = (Param("center", "vector", (0.0, 0.0, 0.0)), Param("radius", "number", 1.0, positive=True))
     kernels = ShapeKernels(hit, normals, uv, spans)
 
+    __slots__ = ("row",)                 # scenes of a million spheres: only the row per sphere
+
     def __init__(self, center=(0.0, 0.0, 0.0), radius: float = 1.0):
-        self.center = np.asarray(center, dtype=float)
-        self.radius = float(radius)
-        self.row = np.array([*self.center, self.radius, self.radius ** 2])
+        center, radius = np.asarray(center, dtype=float), float(radius)
+        self.row = np.array([*center, radius, radius ** 2])
+
+    @property
+    def center(self) -> np.ndarray:
+        return self.row[CENTER:CENTER + 3]
+
+    @property
+    def radius(self) -> float:
+        return float(self.row[RADIUS])
 
     def bounds(self):
         return self.center - self.radius, self.center + self.radius

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli import variants
-from rtcli.core.bvh import BVH
+from rtcli.core.scene import object_tree
 from rtcli.core.vec import unit
 from rtcli.shapes.sphere import Sphere
 from rtcli.variants import INF, select
@@ -33,13 +33,11 @@ class Accelerator:
     """The scene's unbounded objects, and a BVH over its bounded ones."""
 
     def __init__(self, scene):
-        objects, boxes = scene.objects, scene.boxes
-        self.unbounded = [k for k, b in enumerate(boxes) if b is None]
-        self.members = np.array([k for k, b in enumerate(boxes) if b is not None], dtype=np.int64)
-        self.bvh = BVH(np.array([boxes[k][0] for k in self.members]).reshape(-1, 3),
-                       np.array([boxes[k][1] for k in self.members]).reshape(-1, 3), leaf_size=2)
-        self.is_sphere = np.array([b is not None and type(o.shape) is Sphere and o.transform is None
-                                   for o, b in zip(objects, boxes)], dtype=bool)     # by object index
+        objects, bounded = scene.objects, scene.boxes.bounded
+        self.unbounded = np.flatnonzero(~bounded)
+        self.members, self.bvh = object_tree(scene)
+        self.is_sphere = np.array([type(o.shape) is Sphere and o.transform is None for o in objects],
+                                  dtype=bool) & bounded                              # by object index
         self.spheres = np.array([o.shape.row if s else np.zeros(5) for o, s in zip(objects, self.is_sphere)]).T
         self.material = np.array([o.material for o in objects], dtype=np.int64)
         self.shadow = scene.materials.shadow[self.material]
@@ -88,7 +86,7 @@ class Accelerator:
         from rtcli.compiled import query
         from rtcli.compiled.pack import geometry
         if self._geometry is None:
-            self._geometry = geometry(scene, tree=True)
+            self._geometry = geometry(scene, tree=True, bvh=(self.members, self.bvh))
         geo, depth = self._geometry
         n = o.shape[1]
         t, obj, prim = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
