@@ -17,7 +17,7 @@ when numba is installed.
 from __future__ import annotations
 
 from rtcli.compiled.pack import CASTS, KIND, XFORM
-from rtcli.core.bvh import walk, walk_rays
+from rtcli.core.bvh import CHILD, COUNT, walk, walk_rays
 from rtcli.core.transform import ray_to_object
 from rtcli.shapes import SHAPES
 from rtcli.shapes.triangle import triangle_leaf
@@ -121,6 +121,8 @@ def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
             best, obj, prim = t, k, p
             if shadow:
                 return best, obj, prim
+    if g.links[0, CHILD] < 0 and g.links[0, COUNT] == 0:          # no tree (a scene of few objects)
+        return best, obj, prim
     t, k, p = WALK_OBJECTS(g, 0, ox, oy, oz, dx, dy, dz, t_min, best, shadow, stack, 0)
     if k >= 0:
         return t, k, p

@@ -17,7 +17,7 @@ from rtcli.variants import INF, kernel, select
 POINT, NORMAL, E1, E2 = 0, 3, 6, 9                    # the row: point, unit normal n, in-plane axes
 
 
-@kernel(inline=True)
+@kernel
 def plane_t(px, py, pz, nx, ny, nz, ox, oy, oz, dx, dy, dz, t_min, t_max):
     """lambda* = (p1 - a).n / (d.n) (notes 000 11.3.1) for the plane through p1 with normal n;
     inf when parallel or out of (t_min, t_max)."""
@@ -34,7 +34,7 @@ def planar_uv(s, at_point, at_axes, x, y, z):
         dot(qx, qy, qz, s[at_axes + 3], s[at_axes + 4], s[at_axes + 5])
 
 
-@kernel(inline=True)
+@kernel
 def hit(s, pool, ox, oy, oz, dx, dy, dz, t_min, t_max):
     return plane_t(s[POINT], s[POINT + 1], s[POINT + 2], s[NORMAL], s[NORMAL + 1], s[NORMAL + 2],
                    ox, oy, oz, dx, dy, dz, t_min, t_max), 0

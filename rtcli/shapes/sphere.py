@@ -29,7 +29,7 @@ from rtcli.variants import (
 CENTER, RADIUS, RADIUS2 = 0, 3, 4                     # the row: center (3), r, r^2
 
 
-@kernel(inline=True)
+@kernel
 def roots(s, ox, oy, oz, dx, dy, dz):
     """Both roots of A t^2 + 2B t + C = 0, A = |d|^2, B = S.d, C = |S|^2 - r^2, S = o - center.
 
@@ -47,14 +47,14 @@ def roots(s, ox, oy, oz, dx, dy, dz):
     return select(miss, INF, near), select(miss, INF, far)
 
 
-@kernel(inline=True)
+@kernel
 def first_root(near, far, t_min, t_max):
     """The first of two roots in (t_min, t_max), inf if neither is."""
     t = select(near > t_min, near, far)
     return select((t > t_min) & (t < t_max), t, INF)
 
 
-@kernel(inline=True)
+@kernel
 def hit(s, pool, ox, oy, oz, dx, dy, dz, t_min, t_max):
     near, far = roots(s, ox, oy, oz, dx, dy, dz)
     return first_root(near, far, t_min, t_max), 0

@@ -11,7 +11,7 @@ from rtcli.shapes.base import Shape, ShapeKernels
 from rtcli.variants import INF, kernel, select
 
 
-@kernel(inline=True)
+@kernel
 def hit(s, pool, ox, oy, oz, dx, dy, dz, t_min, t_max):
     """The plane z = 0 at t = -oz / dz, inside |x| <= 1 and |y| <= 1."""
     t = -oz / dz
