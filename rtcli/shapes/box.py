@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli.shapes.base import Param, ParamError, Shape, ShapeKernels
-from rtcli.variants import INF, kernel, maximum, minimum, not_, select
+from rtcli.variants import INF, kernel, not_, select
 
 LO, HI = 0, 3                                         # the row: min corner, max corner
 
@@ -25,9 +25,9 @@ def axis_slab(lo, hi, o, d):
     (hi - S_k)/c_k in order; a line parallel to it (c_k = 0) is inside for all t or none."""
     t_lo, t_hi = (lo - o) / d, (hi - o) / d
     within = (o >= lo) & (o <= hi)
-    parallel = d == 0
-    return (select(parallel, select(within, -INF, INF), minimum(t_lo, t_hi)),
-            select(parallel, select(within, INF, -INF), maximum(t_lo, t_hi)))
+    parallel, ordered = d == 0, t_lo < t_hi
+    return (select(parallel, select(within, -INF, INF), select(ordered, t_lo, t_hi)),
+            select(parallel, select(within, INF, -INF), select(ordered, t_hi, t_lo)))
 
 
 @kernel
@@ -38,14 +38,14 @@ def slabs(s, ox, oy, oz, dx, dy, dz):
     t1x, t2x = axis_slab(s[LO], s[HI], ox, dx)
     t1y, t2y = axis_slab(s[LO + 1], s[HI + 1], oy, dy)
     t1z, t2z = axis_slab(s[LO + 2], s[HI + 2], oz, dz)
-    later_y, later_z = t1y > t1x, t1z > maximum(t1x, t1y)
-    t_near = select(later_z, t1z, select(later_y, t1y, t1x))
-    k_in = select(later_z, 2, select(later_y, 1, 0))
-    d_in = select(later_z, dz, select(later_y, dy, dx))
-    sooner_y, sooner_z = t2y < t2x, t2z < minimum(t2x, t2y)
-    t_far = select(sooner_z, t2z, select(sooner_y, t2y, t2x))
-    k_out = select(sooner_z, 2, select(sooner_y, 1, 0))
-    d_out = select(sooner_z, dz, select(sooner_y, dy, dx))
+    later = t1y > t1x
+    t_near, k_in, d_in = select(later, t1y, t1x), select(later, 1, 0), select(later, dy, dx)
+    later = t1z > t_near
+    t_near, k_in, d_in = select(later, t1z, t_near), select(later, 2, k_in), select(later, dz, d_in)
+    sooner = t2y < t2x
+    t_far, k_out, d_out = select(sooner, t2y, t2x), select(sooner, 1, 0), select(sooner, dy, dx)
+    sooner = t2z < t_far
+    t_far, k_out, d_out = select(sooner, t2z, t_far), select(sooner, 2, k_out), select(sooner, dz, d_out)
     face_in = 2 * k_in + select(d_in < 0, 1, 0)
     face_out = 2 * k_out + select(d_out > 0, 1, 0)
     return t_near, face_in, t_far, face_out, t_near > t_far

@@ -35,7 +35,6 @@ from rtcli.variants import (
     copysign,
     isfinite,
     kernel,
-    maximum,
     select,
     sqrt,
 )
@@ -67,7 +66,7 @@ def wall(s, Sx, Sy, Sz, cx, cy, cz):
     B = Sx * cx + Sy * cy - m * w0 * cz
     C = Sx * Sx + Sy * Sy - w0 * w0
     disc = B * B - A * C
-    q = -B - copysign(sqrt(maximum(disc, 0.0)), B)
+    q = -B - copysign(sqrt(select(disc > 0, disc, 0.0)), B)          # no root where disc < 0 (ok below)
     t1, t2 = q / A, C / q
     z1, z2 = Sz + t1 * cz, Sz + t2 * cz
     ok1 = (disc >= 0) & isfinite(t1) & (z1 >= 0) & (z1 <= 1)
