@@ -18,7 +18,7 @@ from rtcli.core.scene import Scene, Settings
 from rtcli.scenefile import yamlfile
 from rtcli.scenefile.files import recording_inputs
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
-from rtcli.scenefile.objects import ObjectBuilder, material_from
+from rtcli.scenefile.objects import ObjectBuilder, material_from, transform_from
 from rtcli.scenefile.params import Params, as_params, describe
 
 
@@ -60,9 +60,19 @@ def camera_form(scene: Scene) -> str:
 
 
 def scene_from_docs(docs: list) -> Scene:
-    """Included documents first, the main file last; only the main file sets camera and image."""
+    """Included documents first, the main file last; only the main file sets camera and image.
+    An animated scene (an `animation:` section) gives its first frame."""
+    if "animation" in docs[-1]:
+        from rtcli.scenefile.animation import Animation
+        return Animation(docs).scene(1)
+    return build_scene(docs)
+
+
+def build_scene(docs: list) -> Scene:
+    """The scene of documents whose values are all plain (an animation's frame: keyframes resolved)."""
     params = [Params(doc, "") for doc in docs]
     main = params[-1]
+    main.known("animation")
     for p in params:
         if p.has("version") and p.raw("version") != 1:
             raise p.error("version", f"unsupported version {describe(p.raw('version'))} (this is version 1)")
@@ -116,17 +126,23 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
 
 
 def camera_from(c: Params):
-    """One of the three camera forms; returns (callable (nc, nr) -> Camera, eye)."""
-    eye = c.vector("eye")
+    """One of the three camera forms; returns (callable (nc, nr) -> Camera, eye).
+
+    An optional `transform:` (the steps of an object's) moves the camera: its points
+    (eye, look_at, lower_left) and directions (up, horizontal, vertical)."""
+    moved = transform_from(c)
+    point = (lambda x: x) if moved is None else moved.point
+    direction = (lambda x: x) if moved is None else moved.vector
+    eye = point(c.vector("eye"))
     if c.has("screen"):
         s = c.sub("screen")
-        ll, h, v = s.vector("lower_left"), s.vector("horizontal"), s.vector("vertical")
+        ll, h, v = point(s.vector("lower_left")), direction(s.vector("horizontal")), direction(s.vector("vertical"))
         s.check_unused()
         if np.linalg.norm(np.cross(h, v)) == 0:
             raise s.error(None, "horizontal and vertical must span a rectangle (not zero or parallel)")
         c.check_unused()
         return functools.partial(cameras.from_screen, eye, ll, h, v), eye
-    look_at, up = c.vector("look_at"), c.vector("up", (0.0, 1.0, 0.0))
+    look_at, up = point(c.vector("look_at")), direction(c.vector("up", (0.0, 1.0, 0.0)))
     if not np.any(look_at - eye):
         raise c.error("look_at", "must differ from eye")
     if np.linalg.norm(np.cross(look_at - eye, up)) <= 1e-9 * np.linalg.norm(look_at - eye) * np.linalg.norm(up):

@@ -55,6 +55,19 @@ class MapNode(dict):
     def value_where(self) -> _Places:
         return _Places(self, 2)
 
+    def copy(self) -> MapNode:
+        """A shallow copy with its own locations, for a copy whose values change (animation.py)."""
+        node = MapNode(self)
+        node.file, node.folder, node.duplicates, node.size = self.file, self.folder, self.duplicates, self.size
+        node.places, node._index = array("Q", self.places), None
+        return node
+
+    def put(self, key, value, place: int | None = None) -> None:
+        """Replace an existing key's value, and where the value is said to be (a packed place)."""
+        self[key] = value
+        if place is not None:
+            self.places[2 * self.index(key) + 2] = place
+
     def index(self, key) -> int:
         """The position of `key` in the dict's order (KeyError if absent)."""
         if len(self) <= 8:
@@ -100,6 +113,18 @@ class SeqNode(list):
     @property
     def item_where(self) -> _Items:
         return _Items(self)
+
+    def copy(self) -> SeqNode:
+        """A shallow copy with its own locations (see MapNode.copy)."""
+        seq = SeqNode(self)
+        seq.file, seq.size, seq.places = self.file, self.size, array("Q", self.places)
+        return seq
+
+    def put(self, k: int, value, place: int | None = None) -> None:
+        """Replace item k, and where it is said to be (a packed place)."""
+        self[k] = value
+        if place is not None:
+            self.places[k + 1] = place
 
 
 class _Items:

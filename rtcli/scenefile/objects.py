@@ -24,6 +24,7 @@ from rtcli.scenefile.guards import bounded, check_count, scale_factors
 from rtcli.scenefile.obj import read_obj
 from rtcli.scenefile.params import Params, as_params, describe
 from rtcli.scenefile.presets import PRESETS
+from rtcli.scenefile.reuse import reused
 from rtcli.scenefile.yamlfile import MapNode
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import REQUIRED, ParamError
@@ -56,7 +57,7 @@ def material_from(p: Params) -> Material:
         transmission=p.coefficient("transmission", 0.0, at_most=1),
         ior=p.number("ior", 1.0, positive=True),
         shadow=p.boolean("shadow", True),
-        texture=None if texture is None else texture_from(texture),
+        texture=None if texture is None else reused(texture.node, None, lambda: texture_from(texture)),
     )
     p.check_unused()
     return m
@@ -248,6 +249,12 @@ class ObjectBuilder:
 
     def shape(self, p: Params, kind: str, material: int):
         sp = self._shape_params(p, kind)
+        if kind == "csg":                 # its children's inline materials join the table in every frame
+            return self._new_shape(sp, kind, material)
+        return reused(p.node[kind] if p.node[kind] is not None else p.node, kind,
+                      lambda: self._new_shape(sp, kind, material))
+
+    def _new_shape(self, sp: Params, kind: str, material: int):
         shape = csg_from(sp, self, material) if kind == "csg" else shape_from(sp, SHAPES[kind])
         sp.check_unused()
         return shape

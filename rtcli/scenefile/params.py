@@ -44,7 +44,8 @@ def out_of_range(x) -> str | None:
 def describe(x) -> str:
     """How a wrong value is shown in a message."""
     if isinstance(x, MapNode):
-        return "a mapping"
+        return "keyframes, which only the values listed under Animation in docs/scene-format.md take, " \
+               "in a scene with an `animation:` section" if "keys" in x else "a mapping"
     if isinstance(x, SeqNode):
         return f"a list of {len(x)}"
     if isinstance(x, str):
