@@ -17,8 +17,9 @@ from rtcli.scenefile.files import kind_of
 from rtcli.writer import image_format
 
 
-def check_outputs(outputs: list[tuple[str, bool]], inputs: list[str]) -> None:
-    """Refuse before rendering: `outputs` are (path, is an id map), `inputs` the files read."""
+def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> None:
+    """Refuse before rendering: `outputs` are (path, is an id map, or "movie" for an animated
+    image), `inputs` the files read."""
     seen: dict = {}
     known = {_identity(p) for p in inputs} - {None}
     reals = {os.path.realpath(p) for p in inputs}
@@ -30,7 +31,11 @@ def check_outputs(outputs: list[tuple[str, bool]], inputs: list[str]) -> None:
         _check_replaceable(path)
         if not os.path.isdir(os.path.dirname(os.path.abspath(path))):
             raise RtcliError(f"{shown(path)}: output folder does not exist")
-        image_format(path, ids)
+        if ids == "movie":
+            from rtcli.movie import movie_format
+            movie_format(path)
+        else:
+            image_format(path, ids)
         if real in seen:
             raise RtcliError(f"{shown(path)}: given for two outputs; they must differ")
         seen[real] = path

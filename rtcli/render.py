@@ -134,23 +134,49 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
     Each tile is converted to 8 bits where it is traced, so no float copy of the
     whole image ever exists.
     """
-    b = job.block_size
-    shape = (job.height, job.width) + (() if job.signature else (3,))
-    image = np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
-    stats, tiles = Stats(), list(_tiles(job, 1 if job.signature else scene.settings.samples))
-    traced = sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
-    engine = None if job.signature else compiled.choose(scene, job.engine, traced, job.bvh)
-    if not engine:
-        wavefront.prepare(scene, job.bvh)
+    image, (tiles, traced) = blank(job), plan(scene, job)
+    stats, engine = Stats(), prepare(scene, job, traced)
     stats.engine = "compiled" if engine else "numpy"            # add() keeps it
     with contextlib.closing(_map_tiles(scene, engine, job, tiles, workers)) as results:     # stops the pool
         for done, (rows, cols, values, s) in enumerate(results, 1):
-            block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
-            image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
+            place(image, job, rows, cols, values)
             stats.add(s)
             if progress:
                 progress(done, len(tiles))
     return image, stats
+
+
+def blank(job: Job) -> np.ndarray:
+    """The job's image before any tile is placed: 8-bit RGB, or 16-bit ids for a signature."""
+    shape = (job.height, job.width) + (() if job.signature else (3,))
+    return np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
+
+
+def plan(scene: Scene, job: Job) -> tuple[list, int]:
+    """(tiles, primary rays the whole job traces): the tiles' (rows, cols) index ranges."""
+    tiles = list(_tiles(job, 1 if job.signature else scene.settings.samples))
+    return tiles, sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
+
+
+def prepare(scene: Scene, job: Job, traced: int):
+    """The compiled engine for the job (rtcli.compiled.choose), or None with the scene readied
+    for the numpy engine."""
+    engine = None if job.signature else compiled.choose(scene, job.engine, traced, job.bvh)
+    if not engine:
+        wavefront.prepare(scene, job.bvh)
+    return engine
+
+
+def run_tiles(scene: Scene, engine, job: Job, tiles: list) -> list:
+    """The tiles traced one after another here: (rows, cols, values, stats) each."""
+    return [_run_tile(scene, engine, job, rows, cols) for rows, cols in tiles]
+
+
+def place(image: np.ndarray, job: Job, rows: np.ndarray, cols: np.ndarray, values: np.ndarray) -> None:
+    """Put a tile's values into the image, each traced pixel over its preview block."""
+    b = job.block_size
+    block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
+    image[rows[0]:rows[-1] + b, cols[0]:cols[-1] + b] = block[:job.height - rows[0], :job.width - cols[0]]
 
 
 def _map_tiles(scene: Scene, engine, job: Job, tiles: list, workers: int):

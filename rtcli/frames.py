@@ -1,0 +1,200 @@
+"""Rendering an animation's frames, and any render on a cluster (README.md, Animation and Clusters).
+
+`rtcli render` comes here for more than a plain still: a frame of an animated scene
+(`--frame N`), a sequence of frames to image files (`-o out/frame_%04d.png`, the
+frame number in printf's %d form) or to a movie (`-o movie.apng`, `--movie`), and
+whatever it renders on a Dask cluster (rtcli/cluster.py). Frames are rendered one
+after another, each on every core (or a frame a task on a cluster), and each file is
+written, atomically, as soon as its frame is done: an interrupted run keeps the frames
+it finished, and `--skip-existing` renders only the frames whose files are missing.
+Every frame is checked (built) before the first is rendered, so an error in any of
+them stops the run before it writes anything.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rtcli import render as renderer
+from rtcli.errors import RtcliError, shown
+from rtcli.movie import check_size, is_movie, write_movie
+from rtcli.scenefile.animation import Animation, load_animation
+from rtcli.stats import Stats
+from rtcli.writer import write_png
+
+PATTERN = re.compile(r"(?:[^%]|%%)*%0?[1-9]?\d*d(?:[^%]|%%)*", re.DOTALL)    # exactly one %d, %04d ...
+
+
+@dataclass
+class Loaded:
+    """A scene file read for a render: its animation, the scene of the frame asked for, the real
+    paths of its inputs, and the files' bytes when they go to a cluster (cluster.Bundle)."""
+
+    animation: Animation
+    scene: object
+    frame: int
+    inputs: list
+    bundle: object = None
+
+
+def load(scene_file: str, frame: int | None = None, keep: bool = False) -> Loaded:
+    """The scene file with frame `frame` (default 1) built; `keep`: also the files' bytes."""
+    from rtcli.scenefile.files import collecting
+    with collecting() if keep else contextlib.nullcontext() as kept:
+        animation, first, inputs = load_animation(scene_file)
+    bundle = None
+    if keep:
+        from rtcli.cluster import Bundle
+        bundle = Bundle.of(scene_file, kept)
+    k = frame or 1
+    if not 1 <= k <= animation.frames:
+        raise RtcliError(f"--frame {k}: {_frames_of(animation, scene_file)}")
+    return Loaded(animation, first if k == 1 else animation.scene(k), k, inputs, bundle)
+
+
+def _frames_of(animation: Animation, scene_file: str) -> str:
+    n = animation.frames
+    return f"{shown(scene_file)} is a still (one frame)" if animation.still else \
+        f"{shown(scene_file)} has {n} frames (1-{n})"
+
+
+def overrides(samples: int | None, max_depth: int | None) -> dict:
+    """The render settings the command line changes."""
+    return {name: v for name, v in (("samples", samples), ("max_depth", max_depth)) if v}
+
+
+def apply(scene, changes: dict):
+    for name, value in changes.items():
+        setattr(scene.settings, name, value)
+    return scene
+
+
+# --- one image ---
+def render_image(loaded: Loaded, job, workers: int, progress=None, where=None, changes: dict | None = None):
+    """The image (or ids) of the loaded frame: on this machine's cores, or on the cluster `where`."""
+    if where is None:
+        return renderer.render(loaded.scene, job, workers, progress)
+    from rtcli.cluster import Session
+    image, stats = renderer.blank(job), Stats()
+    tiles, traced = renderer.plan(loaded.scene, job)
+    with Session(where) as session:
+        results = session.tiles(loaded.bundle, changes or {}, loaded.frame, job, traced, tiles,
+                                1 if job.signature else loaded.scene.settings.samples)
+        for done, (rows, cols, values, s) in enumerate(results, 1):
+            renderer.place(image, job, rows, cols, values)
+            stats.add(s)
+            stats.engine = s.engine
+            if progress:
+                progress(done, len(tiles))
+    return image, stats
+
+
+# --- sequences ---
+def wants_sequence(output: str | None, frames: str | None, movie: str | None) -> bool:
+    """Whether the command writes a sequence of frames (files or a movie) rather than one image."""
+    return bool(frames or movie or is_movie(output) or (output and "%" in output))
+
+
+@dataclass
+class Sequence:
+    """Which frames to render, the file of each (none when only movies are written), the movies."""
+
+    frames: list[int]
+    paths: dict = field(default_factory=dict)
+    movies: list = field(default_factory=list)
+
+
+def sequence(animation: Animation, scene_file: str, output: str | None, frames: str | None,
+             frame: int | None, movie: str | None) -> Sequence:
+    """The frames and files a command asks for (README.md, Animation)."""
+    if frames and frame:
+        raise RtcliError("--frames and --frame: give one")
+    wanted = [frame] if frame else _range(frames, animation, scene_file)
+    movies = [m for m in (output if is_movie(output) else None, movie) if m]
+    if output and not is_movie(output):
+        if "%" in output:
+            if not PATTERN.fullmatch(output):
+                raise RtcliError(f"-o {shown(output)}: a frame pattern has one %d (or %04d ...) for the frame "
+                                 "number, and %% for a percent sign")
+            return Sequence(wanted, {k: output % k for k in wanted}, movies)
+        if len(wanted) > 1:
+            raise RtcliError(f"-o {shown(output)}: {len(wanted)} frames need a name with the frame number "
+                             "(frame_%04d.png) or a movie (.apng, .gif)")
+        return Sequence(wanted, {wanted[0]: output}, movies)
+    if movies:
+        return Sequence(wanted, {}, movies)
+    name = os.path.splitext(os.path.basename(scene_file))[0]
+    return Sequence(wanted, {k: f"{name}_{k:04d}.png" for k in wanted}, movies)
+
+
+def _range(text: str | None, animation: Animation, scene_file: str) -> list[int]:
+    n = animation.frames
+    if not text:
+        return list(range(1, n + 1))
+    m = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", text)
+    first, last = (int(m.group(1)), int(m.group(2) or m.group(1))) if m else (0, 0)
+    if not m or first < 1 or last < first:
+        raise RtcliError(f"--frames {shown(text)}: give a range FIRST-LAST of frame numbers, from 1 (e.g. 1-{n})")
+    if last > n:
+        raise RtcliError(f"--frames {shown(text)}: {_frames_of(animation, scene_file)}")
+    return list(range(first, last + 1))
+
+
+def render_sequence(loaded: Loaded, seq: Sequence, job, workers: int, changes: dict, skip_existing: bool,
+                    progress=None, where=None) -> Stats:
+    """Render the sequence's frames, writing each file as its frame is done and the movies at the
+    end; frames whose files exist are skipped with `skip_existing` (read back for a movie)."""
+    todo = [k for k in seq.frames if not (skip_existing and k in seq.paths and os.path.isfile(seq.paths[k]))]
+    if seq.movies:
+        check_size(len(seq.frames), job.width, job.height)
+    for k in todo:
+        if k != loaded.frame:
+            apply(loaded.animation.scene(k), changes)          # every frame checked before any is rendered
+    movie = {k: _read_back(seq.paths[k], job) for k in seq.frames if k not in todo and seq.movies}
+    stats = Stats()
+    for k, image, s in _frames(loaded, todo, job, workers, changes, progress, where):
+        if k in seq.paths:
+            write_png(seq.paths[k], image)
+        if seq.movies:
+            movie[k] = image
+        stats.add(s)
+        stats.engine = s.engine
+    for path in seq.movies:
+        write_movie(path, [movie[k] for k in seq.frames], loaded.animation.clock.fps)
+    return stats
+
+
+def _frames(loaded: Loaded, todo: list[int], job, workers: int, changes: dict, progress, where):
+    """(frame, image, stats) of each frame to do: here one after another, or on the cluster as they finish."""
+    if where is not None:
+        from rtcli.cluster import Session
+        with Session(where) as session:
+            for done, result in enumerate(session.frames(loaded.bundle, changes, todo, job), 1):
+                if progress:
+                    progress(done, len(todo))
+                yield result
+        return
+    for i, k in enumerate(todo):
+        scene = loaded.scene if k == loaded.frame else apply(loaded.animation.scene(k), changes)
+        step = None if progress is None else (lambda done, total, i=i: progress(i * total + done, len(todo) * total))
+        image, s = renderer.render(scene, job, workers, step)
+        yield k, image, s
+
+
+def _read_back(path: str, job) -> np.ndarray:
+    """A frame written by an earlier run, for a movie."""
+    from PIL import Image, UnidentifiedImageError
+    try:
+        with Image.open(path) as img:
+            pixels = np.asarray(img.convert("RGB"))
+    except (OSError, UnidentifiedImageError) as e:
+        raise RtcliError(f"{shown(path)}: cannot read this earlier frame for the movie: {e}") from None
+    if pixels.shape != (job.height, job.width, 3):
+        raise RtcliError(f"{shown(path)}: an earlier frame of {pixels.shape[1]}x{pixels.shape[0]}, not "
+                         f"{job.width}x{job.height}: render it again (without --skip-existing)")
+    return pixels

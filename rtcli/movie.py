@@ -1,0 +1,70 @@
+"""Animated images: the frames of an animation as one animated PNG or GIF (Pillow).
+
+An animated PNG keeps every pixel; a GIF has at most 256 colors a frame (Pillow
+picks them) and frame delays in hundredths of a second. Both loop forever. The
+movie is written to a temporary file beside its name and renamed into place, so an
+interrupted run leaves no half-written movie; its frames are held in memory until
+then (3 bytes a pixel a frame, checked by `check_size`).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+
+import numpy as np
+from PIL import Image
+
+from rtcli.errors import RtcliError, quoted, shown
+
+FORMATS = {".apng": "PNG", ".gif": "GIF"}
+MAX_BYTES = 4 << 30                       # frames held in memory for one movie
+
+
+def movie_format(path: str) -> str:
+    """The Pillow format of a movie's name; RtcliError for another extension."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in FORMATS:
+        got = f"{quoted(ext)} is not one of" if ext else "no extension; use one of"
+        raise RtcliError(f"{shown(path)}: an animation is written as an animated PNG or GIF: {got} "
+                         f"{', '.join(FORMATS)}")
+    return FORMATS[ext]
+
+
+def is_movie(path: str | None) -> bool:
+    return path is not None and os.path.splitext(path)[1].lower() in FORMATS
+
+
+def check_size(frames: int, width: int, height: int) -> None:
+    """Refuse a movie whose frames would not fit in MAX_BYTES of memory."""
+    need = frames * width * height * 3
+    if need > MAX_BYTES:
+        raise RtcliError(f"a movie of {frames} frames of {width}x{height} holds {need / (1 << 30):.1f} GB of "
+                         f"pixels in memory, more than the {MAX_BYTES >> 30} GB allowed; write the frames "
+                         "to files instead (-o frame_%04d.png)")
+
+
+def write_movie(path: str, frames: list[np.ndarray], fps: float) -> None:
+    """Write uint8 (H, W, 3) frames as a movie at `fps` frames a second, looping."""
+    fmt = movie_format(path)
+    images = [Image.fromarray(f) for f in frames]
+    folder = os.path.dirname(os.path.abspath(path))
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".rtcli-", suffix=os.path.splitext(path)[1], dir=folder)
+    except OSError as e:
+        raise RtcliError(f"cannot write {shown(path)}: {e.strerror}") from None
+    try:
+        with os.fdopen(fd, "wb") as f:
+            images[0].save(f, format=fmt, save_all=True, append_images=images[1:], duration=1000 / fps, loop=0)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, path)
+    except BaseException as e:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        if isinstance(e, OSError):
+            raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
+        raise
