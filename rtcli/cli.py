@@ -145,11 +145,34 @@ def _progress(enabled: bool, label: str):
     return show
 
 
+def _cluster_options(command):
+    """--cluster, --cluster-file and --local-cluster (README.md, Clusters)."""
+    for option in reversed((
+            click.option("--cluster", metavar="tcp://HOST:PORT", callback=_not_empty,
+                         help="Render on the Dask cluster whose scheduler listens there (needs the extra "
+                              "`cluster`; --workers is then unused)."),
+            click.option("--cluster-file", metavar="SCHEDULER.json", callback=_not_empty,
+                         help="Render on the Dask cluster named by this scheduler file."),
+            click.option("--local-cluster", type=click.IntRange(1, 256), metavar="N",
+                         help="Render on a Dask cluster of N worker processes started on this machine."))):
+        command = option(command)
+    return command
+
+
+def _cluster(address, file, local):
+    """The cluster the options name, or None; rtcli.cluster (and Dask) only when one is named."""
+    if not (address or file or local):
+        return None
+    from rtcli.cluster import target
+    return target(address, file, local)
+
+
 @main.command()
 @click.argument("scene_file", metavar="SCENE.yaml")
 @click.option("-o", "--output", metavar="OUT.png", callback=_not_empty,
               help="Output image (default: the scene's name .png); the format follows the extension: "
-                   ".png, .jpg, .bmp, .tif, .webp or .ppm.")
+                   ".png, .jpg, .bmp, .tif, .webp or .ppm. Frames: a name with the frame number as %d "
+                   "(out/frame_%04d.png); a movie: .apng or .gif.")
 @click.option("--width", type=SIZE, help="Image width (the camera is kept).")
 @click.option("--height", type=SIZE, help="Image height (the camera is kept).")
 @click.option("--block-size", type=click.IntRange(1, 1024), default=1, show_default=True,
@@ -166,24 +189,43 @@ def _progress(enabled: bool, label: str):
 @click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
               help="numpy core, or compiled integrator (numba); auto: compiled for big jobs it can render.")
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects: test each against every ray (for comparisons).")
+@click.option("--frames", "frame_range", metavar="FIRST-LAST",
+              help="Render these frames of an animated scene (default with a frame pattern or a movie: all).")
+@click.option("--frame", type=click.IntRange(1), metavar="N", help="Render frame N of an animated scene (default 1).")
+@click.option("--movie", metavar="MOVIE.apng", callback=_not_empty,
+              help="Also write the frames as an animated PNG (.apng) or GIF (.gif).")
+@click.option("--skip-existing", is_flag=True, help="Leave the frames (or image) already written; render the rest.")
+@_cluster_options
 def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
-           gamma, quiet, progress, stats, engine, no_bvh):
-    """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format)."""
-    from rtcli.render import render as render_image
+           gamma, quiet, progress, stats, engine, no_bvh, frame_range, frame, movie, skip_existing,
+           cluster, cluster_file, local_cluster):
+    """Render SCENE.yaml to an image, or an animation's frames (see docs/scene-format.md for the scene format)."""
+    from rtcli import frames as animation
     from rtcli.writer import write_png
     start = time.perf_counter()
     _check_engine(engine)
-    scene, inputs = _load(scene_file)
-    out = _output(scene_file, output)
-    _check_outputs([(out, False)], inputs)
-    if samples:
-        scene.settings.samples = samples
-    if max_depth:
-        scene.settings.max_depth = max_depth
+    where = _cluster(cluster, cluster_file, local_cluster)
+    several = animation.wants_sequence(output, frame_range, movie)
+    loaded = animation.load(scene_file, None if several else frame, keep=where is not None)
+    scene, inputs, changes = loaded.scene, loaded.inputs, animation.overrides(samples, max_depth)
+    if several:
+        seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
+        outs = [(p, False) for p in seq.paths.values()] + [(m, "movie") for m in seq.movies]
+    else:
+        out = _output(scene_file, output)
+        outs = [(out, False)]
+    _check_outputs(outs, inputs)
+    animation.apply(scene, changes)
     job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine, bvh=not no_bvh)
     show = _progress(not quiet and (progress or sys.stderr.isatty()), one_line(os.path.basename(scene_file)))
-    image, counts = render_image(scene, job, workers or os.cpu_count() or 1, show)
-    write_png(out, image)
+    if several:
+        counts = animation.render_sequence(loaded, seq, job, workers or os.cpu_count() or 1, changes,
+                                           skip_existing, show, where)
+    elif skip_existing and os.path.isfile(out):
+        return
+    else:
+        image, counts = animation.render_image(loaded, job, workers or os.cpu_count() or 1, show, where, changes)
+        write_png(out, image)
     if stats:
         seconds = time.perf_counter() - start
         click.echo(f"rays: {counts.primary} primary, {counts.shadow} shadow, {counts.reflected} reflected, "
@@ -203,20 +245,25 @@ def render(scene_file, output, width, height, block_size, samples, max_depth, wo
 @click.option("--block-size", type=click.IntRange(1, 1024), default=1, show_default=True,
               help="One ray per N x N block, through its top-left pixel.")
 @click.option("--workers", type=click.IntRange(1, 256), help="Worker processes (default: all cores).")
-def signature(scene_file, output, ids_out, legend, width, height, block_size, workers):
+@click.option("--frame", type=click.IntRange(1), metavar="N", help="Frame N of an animated scene (default 1).")
+@_cluster_options
+def signature(scene_file, output, ids_out, legend, width, height, block_size, workers, frame,
+              cluster, cluster_file, local_cluster):
     """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
     import numpy as np
 
-    from rtcli.render import render as render_image
+    from rtcli.frames import load, render_image
     from rtcli.writer import signature_colors, write_images
-    scene, inputs = _load(scene_file)
+    where = _cluster(cluster, cluster_file, local_cluster)
+    loaded = load(scene_file, frame, keep=where is not None)
+    scene, inputs = loaded.scene, loaded.inputs
     if len(scene.objects) > 65535:
         raise RtcliError(f"{shown(scene_file)}: {len(scene.objects)} objects, but signature ids are 16-bit "
                          "(at most 65535 objects)")
     out = _output(scene_file, output, ".sig.png")
     _check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), inputs)
     job = _job(scene, width, height, block_size, signature=True)
-    ids, _ = render_image(scene, job, workers or os.cpu_count() or 1)
+    ids, _ = render_image(loaded, job, workers or os.cpu_count() or 1, where=where)
     write_images([(out, signature_colors(ids))] + ([(ids_out, ids)] if ids_out else []))
     if legend:
         counts = np.bincount(ids.ravel(), minlength=len(scene.objects) + 1)
@@ -277,8 +324,10 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
 @click.argument("scene_file", metavar="SCENE.yaml")
 def validate(scene_file):
     """Parse and check a scene; print a summary. Renders nothing."""
+    from rtcli.frames import load
     from rtcli.scenefile.build import summary
-    click.echo(f"{shown(scene_file)}: ok: {summary(_load(scene_file)[0])}")
+    loaded = load(scene_file)
+    click.echo(f"{shown(scene_file)}: ok: {summary(loaded.scene)}{loaded.animation.check_all()}")
 
 
 @main.command()
