@@ -5,12 +5,18 @@ read (opening a FIFO would block, and a device such as /dev/zero never ends), an
 files larger than their documented limit (docs/scene-format.md, "Limits") are
 refused without being read. The real paths of the files a load reads are
 recorded, so the command line can refuse an output that would overwrite one.
+
+A load can also keep the bytes of every file it reads (`collecting`), and another
+load, in another process or on another machine, can read those bytes instead of
+the disk (`serving`): a render spread over a cluster sends its workers the scene
+as the files the client read, so that every worker builds the same scene.
 """
 
 from __future__ import annotations
 
 import contextlib
 import contextvars
+import io
 import os
 import stat
 import warnings
@@ -24,6 +30,8 @@ _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
           (stat.S_ISSOCK, "a socket"))
 
 _read: contextvars.ContextVar[list | None] = contextvars.ContextVar("rtcli_inputs", default=None)
+_kept: contextvars.ContextVar[dict | None] = contextvars.ContextVar("rtcli_kept_files", default=None)
+_served: contextvars.ContextVar[dict | None] = contextvars.ContextVar("rtcli_served_files", default=None)
 
 
 class InputError(OSError):
@@ -49,6 +57,14 @@ def check_input(path: str, limit: int) -> int:
     Uses os.stat, which never opens the file, so a FIFO or a device is refused
     before anything could block on it or read it without end.
     """
+    served = _served.get()
+    if served is not None:
+        if path not in served:
+            raise FileNotFoundError(path)
+        real, data = served[path]
+        if len(data) > limit:
+            raise InputError(f"too large: {len(data) / MB:.1f} MB, more than the {limit // MB} MB allowed")
+        return len(data)
     try:
         st = os.stat(path)
     except FileNotFoundError:
@@ -66,13 +82,49 @@ def check_input(path: str, limit: int) -> int:
 def read_bytes(path: str, limit: int) -> bytes:
     """The whole content of a checked regular file, never more than `limit` bytes."""
     size = check_input(path, limit)
+    served = _served.get()
+    if served is not None:
+        return served[path][1]
     with open(path, "rb") as f:
         data = f.read(size + 1)                   # read(n) reserves n bytes: ask for what stat said
         if len(data) > size:
             data += f.read(limit + 1 - len(data))
     if len(data) > limit:
         raise InputError(f"too large: it grew past the {limit // MB} MB allowed while being read")
+    kept = _kept.get()
+    if kept is not None:
+        kept[path] = (os.path.realpath(path), data)
     return data
+
+
+def real_path(path: str) -> str:
+    """The file's real path (links resolved), as the machine that read it saw it when it is served."""
+    served = _served.get()
+    if served is not None and path in served:
+        return served[path][0]
+    return os.path.realpath(path)
+
+
+@contextlib.contextmanager
+def collecting():
+    """Keeps, in a dict path -> (real path, bytes), every file read inside the block."""
+    kept: dict = {}
+    token = _kept.set(kept)
+    try:
+        yield kept
+    finally:
+        _kept.reset(token)
+
+
+@contextlib.contextmanager
+def serving(files: dict):
+    """Inside the block, files are read from `files` (path -> (real path, bytes), as `collecting`
+    keeps them) instead of the disk; a path it lacks is not found."""
+    token = _served.set(files)
+    try:
+        yield
+    finally:
+        _served.reset(token)
 
 
 def _record(path: str) -> None:
@@ -96,12 +148,16 @@ def recording_inputs():
 def open_image(path: str):
     """A texture opened by Pillow after the checks above; a decompression bomb (more than
     MAX_TEXTURE_PIXELS texels, however small the file) is an InputError, not a warning."""
-    check_input(path, MAX_IMAGE_BYTES)
+    source = path
+    if _served.get() is not None or _kept.get() is not None:
+        source = io.BytesIO(read_bytes(path, MAX_IMAGE_BYTES))
+    else:
+        check_input(path, MAX_IMAGE_BYTES)
     threshold, Image.MAX_IMAGE_PIXELS = Image.MAX_IMAGE_PIXELS, MAX_TEXTURE_PIXELS     # Pillow warns above it
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
-            with Image.open(path) as img:
+            with Image.open(source) as img:
                 w, h = img.size
                 if w * h > MAX_TEXTURE_PIXELS:
                     raise InputError(f"{w}x{h} is {w * h:,} texels, more than the {MAX_TEXTURE_PIXELS:,} allowed")

@@ -23,7 +23,7 @@ import os
 import yaml
 
 from rtcli.errors import SceneError, Where, shown
-from rtcli.scenefile.files import read_bytes
+from rtcli.scenefile.files import read_bytes, real_path
 from rtcli.scenefile.limits import MAX_INCLUDE_DEPTH, MAX_SCENE_BYTES
 from rtcli.scenefile.nodes import MapNode, SeqNode
 from rtcli.scenefile.yamlevents import Builder, Loader
@@ -107,7 +107,7 @@ def load(path: str) -> list[MapNode]:
 
 
 def _load(path: str, where, key: str, stack: tuple, docs: list, seen: set) -> None:
-    real = os.path.realpath(path)
+    real = real_path(path)
     if real in stack:
         chain = " -> ".join(shown(os.path.basename(p)) for p in stack + (real,))
         raise SceneError(where, key, f"include cycle: {chain}")
