@@ -199,7 +199,7 @@ def _cluster(address, file, local):
 def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
            gamma, quiet, progress, stats, engine, no_bvh, frame_range, frame, movie, skip_existing,
            cluster, cluster_file, local_cluster):
-    """Render SCENE.yaml to an image, or an animation's frames (see docs/scene-format.md for the scene format)."""
+    """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames."""
     from rtcli import frames as animation
     from rtcli.writer import write_png
     start = time.perf_counter()
