@@ -22,7 +22,7 @@ import numpy as np
 
 from rtcli import render as renderer
 from rtcli.errors import RtcliError, shown
-from rtcli.movie import check_size, is_movie, write_movie
+from rtcli.movie import check_size, is_movie, movie_format, write_movie
 from rtcli.scenefile.animation import Animation, load_animation
 from rtcli.stats import Stats
 from rtcli.writer import write_png
@@ -114,6 +114,8 @@ def sequence(animation: Animation, scene_file: str, output: str | None, frames: 
     """The frames and files a command asks for (README.md, Animation)."""
     if frames and frame:
         raise RtcliError("--frames and --frame: give one")
+    if movie:
+        movie_format(movie)
     wanted = [frame] if frame else _range(frames, animation, scene_file)
     movies = [m for m in (output if is_movie(output) else None, movie) if m]
     if output and not is_movie(output):

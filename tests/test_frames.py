@@ -1,0 +1,113 @@
+"""rtcli render on animations: frame files, one frame, movies, resuming, and the errors.
+
+The rule the tests pin: every frame's file is byte for byte the file of that frame
+rendered alone, whatever else the command rendered and with how many workers.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from rtcli.cli import main
+
+ORBIT = Path(__file__).resolve().parent.parent / "scenes" / "orbit.yaml"
+SMALL = ["--width", "40", "--height", "30"]
+
+
+@pytest.fixture
+def run(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(ORBIT, tmp_path / "orbit.yaml")
+    runner = CliRunner()
+    return lambda *args: runner.invoke(main, list(args))
+
+
+def test_each_frame_of_a_sequence_is_the_frame_rendered_alone(run, tmp_path):
+    result = run("render", "orbit.yaml", "--frames", "3-7", "-o", "out_%03d.png", "--workers", "2", *SMALL)
+    assert result.exit_code == 0, result.output
+    assert sorted(os.listdir(tmp_path)) == ["orbit.yaml"] + [f"out_{k:03d}.png" for k in range(3, 8)]
+    for k in (3, 5, 7):
+        assert run("render", "orbit.yaml", "--frame", str(k), "-o", "alone.png", "--workers", "1",
+                   *SMALL).exit_code == 0
+        assert (tmp_path / "alone.png").read_bytes() == (tmp_path / f"out_{k:03d}.png").read_bytes(), k
+    frames = [np.asarray(Image.open(tmp_path / f"out_{k:03d}.png")) for k in range(3, 8)]
+    assert all(np.any(a != b) for a, b in zip(frames, frames[1:]))          # the camera moves
+
+
+def test_a_movie_holds_the_frames(run, tmp_path):
+    result = run("render", "orbit.yaml", "--frames", "1-4", "-o", "f%d.png", "--movie", "m.apng", *SMALL)
+    assert result.exit_code == 0, result.output
+    with Image.open(tmp_path / "m.apng") as movie:
+        assert (movie.format, movie.n_frames, movie.info.get("loop")) == ("PNG", 4, 0)
+        for k in range(4):
+            movie.seek(k)
+            assert np.array_equal(np.asarray(movie.convert("RGB")), np.asarray(Image.open(tmp_path / f"f{k + 1}.png")))
+    assert run("render", "orbit.yaml", "-o", "all.gif", *SMALL).exit_code == 0
+    with Image.open(tmp_path / "all.gif") as gif:
+        assert (gif.format, gif.n_frames, gif.info["duration"]) == ("GIF", 24, 80)     # 12 fps: 83 ms -> 80
+    assert sorted(os.listdir(tmp_path)) == ["all.gif", "f1.png", "f2.png", "f3.png", "f4.png", "m.apng", "orbit.yaml"]
+
+
+def test_skip_existing_renders_only_the_missing_frames(run, tmp_path):
+    assert run("render", "orbit.yaml", "--frames", "1-3", "-o", "f%d.png", *SMALL).exit_code == 0
+    first = (tmp_path / "f1.png").read_bytes()
+    os.unlink(tmp_path / "f2.png")
+    os.utime(tmp_path / "f3.png", (0, 0))
+    result = run("render", "orbit.yaml", "--frames", "1-3", "-o", "f%d.png", "--skip-existing",
+                 "--movie", "m.apng", *SMALL)
+    assert result.exit_code == 0, result.output
+    assert os.stat(tmp_path / "f3.png").st_mtime == 0 and (tmp_path / "f1.png").read_bytes() == first
+    assert (tmp_path / "f2.png").exists()
+    with Image.open(tmp_path / "m.apng") as movie:
+        movie.seek(2)
+        assert np.array_equal(np.asarray(movie.convert("RGB")), np.asarray(Image.open(tmp_path / "f3.png")))
+
+
+def test_a_still_render_of_an_animated_scene_is_frame_1(run, tmp_path):
+    assert run("render", "orbit.yaml", "-o", "still.png", *SMALL).exit_code == 0
+    assert run("render", "orbit.yaml", "--frame", "1", "-o", "one.png", *SMALL).exit_code == 0
+    assert (tmp_path / "still.png").read_bytes() == (tmp_path / "one.png").read_bytes()
+
+
+def test_validate_checks_every_frame(run):
+    result = run("validate", "orbit.yaml")
+    assert result.exit_code == 0
+    assert result.output.endswith("; animated: 24 frames at 12 fps (0..2 s), 3 keyframed values\n")
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--frames", "1-30", "-o", "f%d.png"], "--frames 1-30: orbit.yaml has 24 frames (1-24)"),
+    (["--frames", "5-2", "-o", "f%d.png"], "--frames 5-2: give a range FIRST-LAST of frame numbers, from 1 (e.g. 1-24)"),
+    (["--frame", "25"], "--frame 25: orbit.yaml has 24 frames (1-24)"),
+    (["--frames", "1-2", "--frame", "2", "-o", "f%d.png"], "--frames and --frame: give one"),
+    (["--frames", "1-2", "-o", "f.png"], "-o f.png: 2 frames need a name with the frame number (frame_%04d.png) "
+                                         "or a movie (.apng, .gif)"),
+    (["-o", "f%d%s.png"], "-o f%d%s.png: a frame pattern has one %d (or %04d ...) for the frame number, "
+                          "and %% for a percent sign"),
+    (["-o", "f.png", "--movie", "m.mp4"], "m.mp4: an animation is written as an animated PNG or GIF: '.mp4' is "
+                                          "not one of .apng, .gif"),
+    (["-o", "orbit.yaml", "--frame", "2"], "orbit.yaml: is an input of this run; it will not be overwritten "
+                                          "(choose another output name)"),
+])
+def test_frame_option_errors_are_one_line_and_write_nothing(run, tmp_path, args, message):
+    result = run("render", "orbit.yaml", *args, *SMALL)
+    assert (result.exit_code, result.output) == (2, f"error: {message}\n")
+    assert os.listdir(tmp_path) == ["orbit.yaml"]
+
+
+def test_an_error_in_a_later_frame_stops_before_any_file_is_written(run, tmp_path):
+    (tmp_path / "bad.yaml").write_text(
+        "animation: {frames: 4}\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
+        "objects: [{sphere: {}, transform: [{scale: {keys: {0: 1, 0.125: 0}}}]}]\n")
+    result = run("render", "bad.yaml", "-o", "f%d.png", *SMALL)
+    assert (result.exit_code, result.output) == (
+        2, "error: bad.yaml:3:65: objects[0].transform[0].scale: singular transform (determinant 0) "
+           "(at frame 4, time 0.125 s)\n")
+    assert sorted(os.listdir(tmp_path)) == ["bad.yaml", "orbit.yaml"]
