@@ -277,7 +277,7 @@ class Session:
         if self.where.local:
             self.cluster = distributed.LocalCluster(
                 n_workers=self.where.local, threads_per_worker=1, processes=True, host="127.0.0.1",
-                dashboard_address=None, silence_logs=logging.CRITICAL)
+                dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
             self.client = distributed.Client(self.cluster, set_as_default=False)
             return
         try:

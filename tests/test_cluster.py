@@ -1,0 +1,216 @@
+"""Renders on a Dask cluster: byte for byte the local render, whatever the grouping or a killed worker.
+
+One LocalCluster of two worker processes (one thread each) serves the module; its
+scene uses an include, a mesh and a texture, so the workers build it from the bytes
+the client read. The errors (no Dask, no scheduler, other software on a worker, a
+lost cluster) are checked by their one line.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import signal
+import sys
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from rtcli import cluster as dask_cluster
+from rtcli import frames
+from rtcli.cli import main
+from rtcli.errors import RtcliError
+from rtcli.render import Job, render
+
+distributed = pytest.importorskip("distributed")
+
+SCENE = """\
+include: [parts.yaml]
+image: {width: 36, height: 24}
+animation: {fps: 4, frames: 6}
+camera:
+  eye: [0, 1.5, 5]
+  look_at: [0, 0.5, 0]
+  transform: [{rotate: {axis: [0, 1, 0], degrees: {keys: {0: 0, 1.5: 120}}}}]
+lights: [{position: [3, 5, 4], color: {keys: {0: [1, 1, 1], 1: [0.4, 0.6, 1]}}}]
+objects:
+  - {plane: {}, material: {texture: {image: grid.png}, reflection: 0.2}}
+  - {mesh: {file: tri.obj}, material: shiny, transform: [{translate: {keys: {0: [0, 0, 0], 1.5: [0.5, 0.5, 0]}}}]}
+  - {sphere: {center: [1, 0.5, 0], radius: 0.5}, material: {transmission: 0.8, ior: 1.5}}
+"""
+PARTS = "materials: {shiny: {diffuse: [0.8, 0.3, 0.2], specular: 0.5, reflection: 0.3}}\n"
+MESH = "v -1 0 -1\nv 1 0 -1\nv 0 1.5 -1\nv 0 0 0\nf 1 2 3\nf 1 4 3\n"
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                 dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
+    yield c
+    c.close()
+
+
+@pytest.fixture
+def run(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "scene.yaml").write_text(SCENE)
+    (tmp_path / "parts.yaml").write_text(PARTS)
+    (tmp_path / "tri.obj").write_text(MESH)
+    picture = np.random.default_rng(1).integers(0, 255, (8, 8, 3), dtype=np.uint8)
+    Image.fromarray(picture).save(tmp_path / "grid.png")
+    runner = CliRunner()
+    return lambda *args: runner.invoke(main, list(args))
+
+
+def same_files(tmp_path, a: str, b: str) -> bool:
+    return (tmp_path / a).read_bytes() == (tmp_path / b).read_bytes()
+
+
+@pytest.mark.parametrize("rays_per_task", [dask_cluster.RAYS_PER_TASK, 50])
+def test_a_still_on_the_cluster_is_the_local_render(run, tmp_path, cluster, monkeypatch, rays_per_task):
+    """Tiles in groups (a few, or one tile a task) give the local render's bytes, on any frame."""
+    monkeypatch.setattr(dask_cluster, "RAYS_PER_TASK", rays_per_task)
+    for frame in ("1", "4"):
+        assert run("render", "scene.yaml", "--frame", frame, "--tile", "8", "-o", "local.png").exit_code == 0
+        result = run("render", "scene.yaml", "--frame", frame, "--tile", "8", "-o", "cluster.png",
+                     "--cluster", cluster.scheduler_address, "--stats")
+        assert result.exit_code == 0, result.output
+        assert "864 primary" in result.output and "numpy engine" in result.output
+        assert same_files(tmp_path, "local.png", "cluster.png"), frame
+
+
+def test_a_signature_on_the_cluster_is_the_local_one(run, tmp_path, cluster):
+    assert run("signature", "scene.yaml", "--ids", "local_ids.png", "-o", "local.png").exit_code == 0
+    path = tmp_path / "scheduler.json"
+    path.write_text(json.dumps({"address": cluster.scheduler_address}))
+    result = run("signature", "scene.yaml", "--ids", "ids.png", "-o", "sig.png", "--cluster-file", str(path))
+    assert result.exit_code == 0, result.output
+    assert same_files(tmp_path, "local_ids.png", "ids.png") and same_files(tmp_path, "local.png", "sig.png")
+
+
+def test_frames_on_the_cluster_are_the_local_frames(run, tmp_path, cluster):
+    assert run("render", "scene.yaml", "-o", "local_%d.png", "--movie", "local.apng").exit_code == 0
+    result = run("render", "scene.yaml", "-o", "c_%d.png", "--movie", "c.apng", "--cluster", cluster.scheduler_address)
+    assert result.exit_code == 0, result.output
+    for k in range(1, 7):
+        assert same_files(tmp_path, f"local_{k}.png", f"c_{k}.png"), k
+    assert same_files(tmp_path, "local.apng", "c.apng")
+
+
+def test_a_killed_worker_costs_time_not_correctness(run, tmp_path, cluster):
+    """A worker killed (SIGKILL) after the first frame: its frames run again elsewhere, same bytes."""
+    assert run("render", "scene.yaml", "-o", "local_%d.png").exit_code == 0
+    loaded = frames.load("scene.yaml", keep=True)
+    seq = frames.sequence(loaded.animation, "scene.yaml", "c_%d.png", None, None, None)
+    with distributed.Client(cluster.scheduler_address, set_as_default=False) as client:
+        pids = client.run(os.getpid)
+        killed = []
+
+        def kill_one(done, total):
+            if not killed:
+                killed.append(pids[sorted(pids)[0]])
+                os.kill(killed[0], signal.SIGKILL)
+        job = Job(36, 24)
+        frames.render_sequence(loaded, seq, job, 1, {}, False, kill_one, dask_cluster.Target(cluster.scheduler_address))
+        client.wait_for_workers(2, timeout=60)
+        assert killed and killed[0] not in client.run(os.getpid).values()        # the nanny started another
+    for k in range(1, 7):
+        assert same_files(tmp_path, f"local_{k}.png", f"c_{k}.png"), k
+
+
+def test_a_worker_with_other_software_is_refused(run, tmp_path, cluster, monkeypatch):
+    ours = dict(dask_cluster.fingerprint(), numpy="0.0")
+    monkeypatch.setattr(dask_cluster, "_fingerprint", ours)
+    result = run("render", "scene.yaml", "-o", "c.png", "--cluster", cluster.scheduler_address)
+    assert result.exit_code == 2
+    line = result.output
+    assert line.startswith("error: the worker tcp://127.0.0.1:") and line.count("\n") == 1
+    assert line.endswith(f"runs other software (numpy 0.0 here, {np.__version__} there): its pixels could differ; "
+                         "install the same rtcli and libraries on every worker\n")
+    assert not (tmp_path / "c.png").exists()
+
+
+def test_a_task_on_a_worker_refuses_a_client_with_other_software(cluster):
+    spec = {"fingerprint": dict(dask_cluster.fingerprint(), rtcli="0.0")}
+    with distributed.Client(cluster.scheduler_address, set_as_default=False) as client:
+        future = client.submit(dask_cluster.frame_task, spec, {}, 1, Job(4, 4), pure=False)
+        with pytest.raises(RtcliError, match=r"runs other software \(rtcli 0.0 here, 0.1.0 \(sources"):
+            future.result()
+
+
+def test_the_local_cluster_option(run, tmp_path):
+    assert run("render", "scene.yaml", "--frame", "2", "-o", "local.png").exit_code == 0
+    result = run("render", "scene.yaml", "--frame", "2", "-o", "c.png", "--local-cluster", "2")
+    assert result.exit_code == 0, result.output
+    assert same_files(tmp_path, "local.png", "c.png")
+
+
+def test_a_lost_cluster_keeps_the_frames_done_and_says_so(run, tmp_path):
+    lost = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                    dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
+    loaded = frames.load("scene.yaml", keep=True)
+    seq = frames.sequence(loaded.animation, "scene.yaml", "c_%d.png", None, None, None)
+    where = dask_cluster.Target(lost.scheduler_address)
+    with pytest.raises(RtcliError) as e:
+        frames.render_sequence(loaded, seq, Job(36, 24), 1, {}, False, lambda done, total: lost.close(), where)
+    assert str(e.value) == (f"lost the Dask scheduler at {lost.scheduler_address} mid-render "
+                            "(FutureCancelledError); the render was stopped")
+    written = sorted(p for p in os.listdir(tmp_path) if p.startswith("c_"))
+    assert written and len(written) < 6 and not [p for p in os.listdir(tmp_path) if p.startswith(".rtcli-")]
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--cluster", "tcp://127.0.0.1:1"], "cannot reach the Dask scheduler at tcp://127.0.0.1:1: Timed out trying "
+                                         "to connect to tcp://127.0.0.1:1 after 0.5 s"),
+    (["--cluster-file", "nowhere.json"], "--cluster-file nowhere.json: file not found"),
+    (["--cluster-file", "scene.yaml"], "--cluster-file scene.yaml: not a Dask scheduler file (Expecting value: "
+                                       "line 1 column 1 (char 0))"),
+    (["--cluster", "tcp://127.0.0.1:1", "--local-cluster", "2"], "--cluster and --local-cluster: give one way "
+                                                                 "to reach a cluster"),
+])
+def test_cluster_errors_are_one_line(run, tmp_path, args, message):
+    import dask
+    with dask.config.set({"distributed.comm.timeouts.connect": "0.5s"}):
+        result = run("render", "scene.yaml", "-o", "c.png", *args)
+    assert (result.exit_code, result.output) == (2, f"error: {message}\n")
+    assert not (tmp_path / "c.png").exists()
+
+
+@pytest.mark.parametrize("command", ["render", "signature"])
+def test_without_dask_the_error_names_the_extra(run, tmp_path, monkeypatch, command):
+    monkeypatch.setitem(sys.modules, "distributed", None)                 # import distributed fails
+    result = run(command, "scene.yaml", "-o", "c.png", "--local-cluster", "2")
+    assert (result.exit_code, result.output) == (2, "error: a cluster needs Dask's distributed scheduler, which is "
+                                                    "not installed: pip install -e '.[cluster]' in the rtcli folder "
+                                                    "(rtcli is not on the package index)\n")
+    assert not (tmp_path / "c.png").exists()
+
+
+def test_groups_are_about_rays_per_task_and_several_per_worker():
+    tiles = [(np.arange(16), np.arange(16))] * 100                      # 256 rays a tile
+    assert sorted(len(g) for g in dask_cluster.groups(tiles, 1, 2)) == [12] * 4 + [13] * 4
+    assert sum(map(len, dask_cluster.groups(tiles, 1, 2))) == 100
+    big = [(np.arange(128), np.arange(128))] * 400                      # 6.5 million rays
+    assert len(dask_cluster.groups(big, 1, 1)) == 4 and len(dask_cluster.groups(big, 2, 1)) == 14
+    assert len(dask_cluster.groups(tiles[:3], 1, 8)) == 3
+
+
+def test_a_scene_builds_from_the_bytes_a_load_kept(run, tmp_path, monkeypatch):
+    """The files a load read, served from memory elsewhere (another folder: nothing on disk), give
+    the same scene; each content once in the bundle."""
+    (tmp_path / "twice.yaml").write_text(SCENE.replace("parts.yaml]", "parts.yaml, copy.yaml]"))
+    (tmp_path / "copy.yaml").write_text(PARTS)
+    loaded = frames.load("twice.yaml", frame=3, keep=True)
+    bundle = loaded.bundle
+    assert sorted(os.path.basename(m[0]) for m in bundle.manifest) == \
+        ["copy.yaml", "grid.png", "parts.yaml", "tri.obj", "twice.yaml"]
+    assert len(bundle.blobs) == 4 and bundle.size == sum(len(b) for b in bundle.blobs.values())
+    monkeypatch.chdir(tmp_path.parent)
+    spec = {"key": bundle.key, "scene_path": bundle.scene_path, "manifest": bundle.manifest, "overrides": {}}
+    scene = dask_cluster._scene(spec, bundle.blobs, 3)
+    a, _ = render(scene, Job(36, 24))
+    b, _ = render(loaded.scene, Job(36, 24))
+    assert a.tobytes() == b.tobytes()
