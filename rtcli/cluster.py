@@ -31,6 +31,7 @@ import hashlib
 import json
 import logging
 import math
+import signal
 import sys
 import threading
 import warnings
@@ -275,9 +276,10 @@ class Session:
 
     def _connect(self, distributed) -> None:
         if self.where.local:
-            self.cluster = distributed.LocalCluster(
-                n_workers=self.where.local, threads_per_worker=1, processes=True, host="127.0.0.1",
-                dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
+            with _sigint_ignored():              # the workers leave Ctrl-C to this process, which stops them
+                self.cluster = distributed.LocalCluster(
+                    n_workers=self.where.local, threads_per_worker=1, processes=True, host="127.0.0.1",
+                    dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
             self.client = distributed.Client(self.cluster, set_as_default=False)
             return
         try:
@@ -354,6 +356,20 @@ class Session:
             raise
         except Exception as e:           # a failure on a worker: shown in one line
             raise RtcliError(f"a worker failed: {type(e).__name__}: {e}") from None
+
+
+@contextlib.contextmanager
+def _sigint_ignored():
+    """SIGINT ignored meanwhile, so that processes started inside the block inherit it ignored (Python
+    keeps an ignored SIGINT ignored): Ctrl-C at a terminal signals the whole process group."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _timeout() -> float:
