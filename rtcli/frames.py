@@ -156,10 +156,10 @@ def render_sequence(loaded: Loaded, seq: Sequence, job, workers: int, changes: d
         check_size(len(seq.frames), job.width, job.height)
     for k in todo:
         if k != loaded.frame:
-            apply(loaded.animation.scene(k), changes)          # every frame checked before any is rendered
+            loaded.animation.scene(k)                          # every frame checked before any is rendered
     movie = {k: _read_back(seq.paths[k], job) for k in seq.frames if k not in todo and seq.movies}
     stats = Stats()
-    for k, image, s in _frames(loaded, todo, job, workers, changes, progress, where):
+    for k, image, s in _frames(loaded, todo, job, workers, changes, progress, where) if todo else ():
         if k in seq.paths:
             write_png(seq.paths[k], image)
         if seq.movies:

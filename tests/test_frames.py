@@ -111,3 +111,14 @@ def test_an_error_in_a_later_frame_stops_before_any_file_is_written(run, tmp_pat
         2, "error: bad.yaml:3:65: objects[0].transform[0].scale: singular transform (determinant 0) "
            "(at frame 4, time 0.125 s)\n")
     assert sorted(os.listdir(tmp_path)) == ["bad.yaml", "orbit.yaml"]
+
+
+def test_skip_existing_with_every_frame_written_renders_nothing_and_reaches_no_cluster(run, tmp_path):
+    assert run("render", "orbit.yaml", "--frames", "1-2", "-o", "f%d.png", *SMALL).exit_code == 0
+    before = {p: os.stat(tmp_path / p).st_mtime_ns for p in ("f1.png", "f2.png")}
+    result = run("render", "orbit.yaml", "--frames", "1-2", "-o", "f%d.png", "--skip-existing", "--movie", "m.gif",
+                 "--cluster", "tcp://127.0.0.1:1", *SMALL)         # nothing listens there: never asked
+    assert (result.exit_code, result.output) == (0, "")
+    assert {p: os.stat(tmp_path / p).st_mtime_ns for p in ("f1.png", "f2.png")} == before
+    with Image.open(tmp_path / "m.gif") as movie:
+        assert movie.n_frames == 2
