@@ -295,7 +295,12 @@ class Session:
             self.client.wait_for_workers(1, timeout=_timeout())
         except (TimeoutError, distributed.TimeoutError):
             raise RtcliError(f"{self.where} has no workers (start some: README.md, Clusters)") from None
-        for address, theirs in sorted(self.client.run(fingerprint).items()):
+        try:
+            found = self.client.run(fingerprint)
+        except Exception as e:            # a worker without rtcli, or with one too old to say what it runs
+            raise RtcliError(f"the workers of {self.where} cannot run rtcli ({type(e).__name__}: {e}); install "
+                             "the same rtcli and libraries on every worker") from None
+        for address, theirs in sorted(found.items()):
             if (refusal := mismatch(fingerprint(), theirs, address)) is not None:
                 raise refusal
 
