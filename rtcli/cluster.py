@@ -388,13 +388,15 @@ def _timeout() -> float:
 def _quiet():
     """Dask's log lines and warnings (a worker restarted, a large graph) stay off the terminal:
     rtcli speaks in one line."""
-    logger = logging.getLogger("distributed")
-    level = logger.level
-    logger.setLevel(logging.CRITICAL)
+    handlers = logging.getLogger("distributed").handlers       # Dask's own, fed by all its loggers
+    levels = [h.level for h in handlers]
+    for h in handlers:
+        h.setLevel(logging.CRITICAL + 1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
             yield
         finally:
-            logger.setLevel(level)
+            for h, level in zip(handlers, levels):
+                h.setLevel(level)
 
