@@ -31,6 +31,7 @@ import hashlib
 import json
 import logging
 import math
+import re
 import signal
 import sys
 import threading
@@ -74,7 +75,17 @@ def target(address: str | None, file: str | None, local: int | None) -> Target |
         return None
     if file:
         address = _scheduler_address(file)
+    if address:
+        address = _checked_address(address, f"--cluster-file {shown(file)}: its address" if file else "--cluster")
     return Target(address, file, local or 0)
+
+
+def _checked_address(address: str, what: str) -> str:
+    """A scheduler's address as Dask takes it, tcp:// added when no scheme is given."""
+    full = address if "://" in address else f"tcp://{address}"
+    if not re.fullmatch(r"(tcp|tls|ws|wss)://(\[[0-9a-fA-F:.]+\]|[^\s/:\[\]]+):\d{1,5}", full):
+        raise RtcliError(f"{what} {shown(address)}: give the scheduler's address as tcp://HOST:PORT")
+    return full
 
 
 def _scheduler_address(path: str) -> str:
@@ -284,7 +295,7 @@ class Session:
             return
         try:
             self.client = distributed.Client(self.where.address, set_as_default=False)
-        except (OSError, TimeoutError) as e:
+        except (OSError, TimeoutError, ValueError) as e:
             raise RtcliError(f"cannot reach the Dask scheduler at {shown(self.where.address)}: "
                              f"{' '.join(str(e).split())}") from None
 

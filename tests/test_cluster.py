@@ -165,6 +165,7 @@ def test_a_lost_cluster_keeps_the_frames_done_and_says_so(run, tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["--cluster", "tcp://127.0.0.1:1"], "cannot reach the Dask scheduler at tcp://127.0.0.1:1: Timed out trying "
                                          "to connect to tcp://127.0.0.1:1 after 0.5 s"),
+    (["--cluster", "scheduler"], "--cluster scheduler: give the scheduler's address as tcp://HOST:PORT"),
     (["--cluster-file", "nowhere.json"], "--cluster-file nowhere.json: file not found"),
     (["--cluster-file", "scene.yaml"], "--cluster-file scene.yaml: not a Dask scheduler file (Expecting value: "
                                        "line 1 column 1 (char 0))"),
