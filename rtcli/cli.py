@@ -84,12 +84,6 @@ def main(debug):
     # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
-def _load(path):
-    """(scene, real paths of every file it read)."""
-    from rtcli.scenefile.build import load_scene_and_inputs
-    return load_scene_and_inputs(path)
-
-
 def _not_empty(ctx, param, value):
     if value is not None and not value.strip():
         raise click.BadParameter("must not be empty", ctx, param)
