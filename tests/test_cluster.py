@@ -215,3 +215,34 @@ def test_a_scene_builds_from_the_bytes_a_load_kept(run, tmp_path, monkeypatch):
     a, _ = render(scene, Job(36, 24))
     b, _ = render(loaded.scene, Job(36, 24))
     assert a.tobytes() == b.tobytes()
+
+
+def test_workers_keep_the_scene_they_built_between_tasks(run, tmp_path, cluster, monkeypatch):
+    """Many tasks of one still: each worker holds one parsed scene and one built frame for it."""
+    monkeypatch.setattr(dask_cluster, "RAYS_PER_TASK", 50)
+    loaded = frames.load("scene.yaml", frame=2, keep=True)
+    image, _ = frames.render_image(loaded, Job(36, 24, tile=4), 1, None, dask_cluster.Target(cluster.scheduler_address))
+    assert image.tobytes() == render(loaded.scene, Job(36, 24))[0].tobytes()
+    key = loaded.bundle.key
+
+    def kept():
+        return ([k for k in dask_cluster._animations if k == key],
+                [k[1] for k in dask_cluster._scenes if k[0] == key])
+    with distributed.Client(cluster.scheduler_address, set_as_default=False) as client:
+        for animations, scenes in client.run(kept).values():
+            assert (animations, scenes) in (([key], [2]), ([], []))      # a worker that got no task keeps none
+
+
+def test_a_scheduler_without_workers_is_named(run, tmp_path):
+    import dask
+    empty = distributed.LocalCluster(n_workers=0, processes=False, dashboard_address="127.0.0.1:0",
+                                     silence_logs=logging.CRITICAL)
+    try:
+        with dask.config.set({"distributed.comm.timeouts.connect": "0.5s"}):
+            with pytest.raises(RtcliError) as e:
+                frames.render_image(frames.load("scene.yaml", keep=True), Job(36, 24), 1, None,
+                                    dask_cluster.Target(empty.scheduler_address))
+        assert str(e.value) == (f"the Dask scheduler at {empty.scheduler_address} has no workers "
+                                "(start some: README.md, Clusters)")
+    finally:
+        empty.close()
