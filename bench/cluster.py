@@ -88,8 +88,6 @@ def task_costs(address: str, workers: int, runs: int = 200) -> tuple[float, floa
     """(work, round trip, busy time a task adds to a worker), in seconds, of tile groups of one
     pixel of the Whitted scene, whose built scene every worker keeps after its first task."""
     sys.path.insert(0, ROOT)
-    from distributed import wait
-
     from rtcli import cluster, frames
     from rtcli.render import Job, plan, prepare, run_tiles
     loaded = frames.load(os.path.join(ROOT, "scenes", "whitted.yaml"), keep=True)
@@ -107,14 +105,14 @@ def task_costs(address: str, workers: int, runs: int = 200) -> tuple[float, floa
 
         def submit():
             return client.submit(cluster.tiles_task, spec, blobs, 1, job, traced, tiles, pure=False)
-        wait([submit() for _ in range(8 * workers)])                  # every worker has built the scene
+        client.gather([submit() for _ in range(8 * workers)])         # every worker has built the scene
         trips = []
         for _ in range(runs // 4):
             start = time.perf_counter()
             submit().result()
             trips.append(time.perf_counter() - start)
         start = time.perf_counter()
-        wait([submit() for _ in range(runs)])
+        client.gather([submit() for _ in range(runs)])
         busy = (time.perf_counter() - start) * workers / runs
     return statistics.median(here), statistics.median(trips), busy
 
