@@ -149,7 +149,8 @@ def shade_local(g, s, ray, f, counts, stack):
                          entering)
         eta = n1 / n2
         tx, ty, tz, tir = refract(Dx, Dy, Dz, nx, ny, nz, eta)
-        wr, wt = split(s, m, fresnel(-dot(Dx, Dy, Dz, nx, ny, nz), eta), tir, s.reflect_tir)
+        R = fresnel(-dot(Dx, Dy, Dz, nx, ny, nz), eta) if s.fresnel[m] else 0.0      # split needs it only then
+        wr, wt = split(s, m, R, tir, s.reflect_tir)
         f[W_REFLECT], f[W_REFLECT + 1], f[W_REFLECT + 2] = wr
         f[W_REFRACT], f[W_REFRACT + 1], f[W_REFRACT + 2] = wt
         f[REFRACTED_DIR], f[REFRACTED_DIR + 1], f[REFRACTED_DIR + 2] = tx, ty, tz
