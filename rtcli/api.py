@@ -65,7 +65,7 @@ def render(scene, *, width: int | None = None, height: int | None = None, sample
                   workers=workers, block_size=block_size, tile=tile, gamma=gamma, bvh=bvh, linear=linear)
     if linear and gamma:
         raise RtcliError("gamma encodes 8-bit images; a linear render is converted by image.to_8bit(gamma=True)")
-    _check_engine(engine)
+    check_engine(engine)
     w, h, note = image_size(scene.model, width, height)
     if note:
         (notes or _warn)(note)
@@ -133,7 +133,8 @@ def _run(scene: Scene, job, workers: int | None, progress):
     return pixels, counts, time.perf_counter() - start
 
 
-def _check_engine(engine: str) -> None:
+def check_engine(engine: str) -> None:
+    """RtcliError when the compiled engine is asked for without numba."""
     from rtcli import variants
     if engine == "compiled" and not variants.ENABLED:
         raise RtcliError("--engine compiled needs numba: pip install -e '.[fast]' in the rtcli folder "

@@ -43,7 +43,8 @@ class RenderStats:
 
     def as_dict(self) -> dict:
         """The fields, total and rays_per_second: what `rtcli render --stats --json` prints."""
-        return {**asdict(self), "total": self.total, "rays_per_second": round(self.rays_per_second)}
+        return {**asdict(self), "seconds": round(self.seconds, 6), "total": self.total,
+                "rays_per_second": round(self.rays_per_second)}
 
     def line(self, seconds: float | None = None) -> str:
         """The one line of `rtcli render --stats` (over `seconds`, when another span is meant)."""
