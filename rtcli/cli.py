@@ -190,8 +190,8 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
 
 
 @main.command()
-@click.argument("actual", metavar="ACTUAL.png")
-@click.argument("expected", metavar="EXPECTED.png")
+@click.argument("actual", metavar="ACTUAL.png|ACTUAL_DIR")
+@click.argument("expected", metavar="EXPECTED.png|EXPECTED_DIR")
 @click.option("--diff", metavar="DIFF.png", callback=_not_empty, help="Write a heat map of the difference.")
 @click.option("--flip", "flip_out", metavar="FLIP.png", callback=_not_empty,
               help="Also write NVIDIA FLIP's perceptual error map and add its mean to the summary "
@@ -207,16 +207,29 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
 @click.option("--max-boundary-mismatch", type=click.IntRange(0), default=8, show_default=True,
               help="--ids: mismatches allowed on id boundaries (or the fraction below, if larger).")
 @click.option("--max-boundary-fraction", type=click.FloatRange(0, 1), default=0.01, show_default=True)
+@click.option("--report", "report_dir", metavar="DIR", callback=_not_empty,
+              help="Folders: write an HTML report there (index.html and its pictures), worst pair first.")
+@click.option("--junit", "junit_file", metavar="FILE", callback=_not_empty,
+              help="Folders: write the results as JUnit XML, one test case per pair.")
 def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixels, max_bad_fraction,
-            max_cluster, max_boundary_mismatch, max_boundary_fraction):
-    """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it."""
+            max_cluster, max_boundary_mismatch, max_boundary_fraction, report_dir, junit_file):
+    """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it.
+
+    Given two folders, compare every .png in them paired by relative path: exit 0 when every
+    pair passes, 1 when one fails or is missing or extra.
+    """
     from rtcli import compare as cmp
     from rtcli.writer import write_images
-    _check_outputs([(p, False) for p in (diff, flip_out) if p], [actual, expected])
-    a, e = cmp.read_png(actual), cmp.read_png(expected)
     id_options = dict(max_boundary_mismatch=max_boundary_mismatch, max_boundary_fraction=max_boundary_fraction)
     image_options = dict(tolerance=tolerance, max_bad_pixels=max_bad_pixels,
                          max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
+    if _folders(actual, expected, diff or flip_out or ids_mode, report_dir or junit_file):
+        from rtcli.compare_dirs import compare_dirs
+        if not compare_dirs(actual, expected, image_options, id_options, report_dir, junit_file, click.echo):
+            raise click.exceptions.Exit(1)
+        return
+    _check_outputs([(p, False) for p in (diff, flip_out) if p], [actual, expected])
+    a, e = cmp.read_png(actual), cmp.read_png(expected)
     if ids_mode:
         result = cmp.compare_ids(a, e, **id_options)
     else:
@@ -234,6 +247,20 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
     click.echo(summary)
     if not result.ok:
         raise click.exceptions.Exit(1)
+
+
+def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
+    """Whether compare is given two folders; a usage error for a folder and a file, or for options
+    of the other mode."""
+    folders = os.path.isdir(actual), os.path.isdir(expected)
+    if folders[0] != folders[1]:
+        raise click.UsageError(f"{shown(actual if folders[0] else expected)} is a folder: compare two folders "
+                               "or two images")
+    if folders[0] and pair_options:
+        raise click.UsageError("--diff, --flip and --ids compare two images; two folders get --report")
+    if not folders[0] and folder_options:
+        raise click.UsageError("--report and --junit compare two folders")
+    return folders[0]
 
 
 @main.command()

@@ -123,7 +123,7 @@ def _write_temp(path: str, pixels: np.ndarray) -> str:
     try:
         with os.fdopen(fd, "wb") as f:
             img.save(f, format=fmt, **options)
-        os.chmod(tmp, 0o666 & ~_umask())               # as a plain open() would (mkstemp makes 0600)
+        os.chmod(tmp, 0o666 & ~current_umask())               # as a plain open() would (mkstemp makes 0600)
     except BaseException:
         _remove(tmp)
         raise
@@ -137,7 +137,8 @@ def _remove(path: str) -> None:
         pass
 
 
-def _umask() -> int:
+def current_umask() -> int:
+    """The process's umask (read by setting it and back), for files made by mkstemp, which are 0600."""
     mask = os.umask(0)
     os.umask(mask)
     return mask
