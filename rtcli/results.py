@@ -58,19 +58,21 @@ class ImageArray(np.ndarray):
     """A rendered image or id map: a numpy array that shows itself in Jupyter and saves itself.
 
     `stats` is the RenderStats of the render that made it (None on arrays derived from it);
-    `inputs` the files the scene read, which save() refuses to overwrite.
+    `inputs` the files the scene read, which save() refuses to overwrite; `picture` how a
+    debug view (rtcli.view) shows, 8-bit (None for images, which show as themselves).
     """
 
     stats: RenderStats | None
     inputs: tuple[str, ...]
+    picture: np.ndarray | None
 
-    def __new__(cls, pixels, stats: RenderStats | None = None, inputs=()) -> ImageArray:
+    def __new__(cls, pixels, stats: RenderStats | None = None, inputs=(), picture=None) -> ImageArray:
         image = np.asarray(pixels).view(cls)
-        image.stats, image.inputs = stats, tuple(inputs)
+        image.stats, image.inputs, image.picture = stats, tuple(inputs), picture
         return image
 
     def __array_finalize__(self, obj) -> None:
-        self.stats, self.inputs = None, getattr(obj, "inputs", ())
+        self.stats, self.inputs, self.picture = None, getattr(obj, "inputs", ()), None
 
     @property
     def is_ids(self) -> bool:
@@ -79,8 +81,11 @@ class ImageArray(np.ndarray):
 
     def to_8bit(self, gamma: bool = False) -> ImageArray:
         """The 8-bit image: linear colors clamped to [0, 1], optionally sRGB-encoded, rounded; an id
-        map as its signature picture (a fixed color per id, as `rtcli signature` draws it)."""
+        map as its signature picture (a fixed color per id, as `rtcli signature` draws it); a
+        debug view as its picture."""
         from rtcli.writer import signature_colors, to_8bit
+        if self.picture is not None:
+            return ImageArray(self.picture, inputs=self.inputs)
         if self.is_ids:
             return ImageArray(signature_colors(np.asarray(self)), inputs=self.inputs)
         if self.ndim != 3 or self.shape[2] != 3:
@@ -107,7 +112,8 @@ class ImageArray(np.ndarray):
     def _repr_png_(self) -> bytes | None:
         """PNG bytes for Jupyter: the 8-bit image, or the signature picture of ids; None (plain text)
         for an array that is neither."""
-        if not (self.is_ids or (self.ndim == 3 and self.shape[2] == 3 and self.dtype.kind in "uf")):
+        if not (self.picture is not None or self.is_ids
+                or (self.ndim == 3 and self.shape[2] == 3 and self.dtype.kind in "uf")):
             return None
         return png_bytes(np.asarray(self.to_8bit()))
 
