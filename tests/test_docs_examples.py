@@ -64,7 +64,9 @@ def test_the_ci_example_passes_then_catches_a_change(tmp_path):
     (tmp_path / "ci").mkdir()
     (tmp_path / "ci" / "golden.sh").write_text(script)
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
-    sh = lambda text: subprocess.run(["sh", "-c", text], cwd=tmp_path, env=env, capture_output=True, text=True)  # noqa: E731
+
+    def sh(text: str):
+        return subprocess.run(["sh", "-c", text], cwd=tmp_path, env=env, capture_output=True, text=True)
     assert sh(make_goldens).returncode == 0
     passed = sh("sh ci/golden.sh")
     assert passed.returncode == 0, passed.stdout + passed.stderr
