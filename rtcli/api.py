@@ -20,15 +20,17 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
 from rtcli.errors import RtcliError, shown
 from rtcli.render import TILE
 from rtcli.results import ImageArray, RenderStats
-from rtcli.scene_api import Scene, check_options, image_size, load
+from rtcli.scene_api import Scene, Source, check_options, image_size, load
 
 Progress = Callable[[int, int], None]          # (tiles done, tiles in all)
 
 
-def load_scene(source, *, width: int | None = None, height: int | None = None, samples: int | None = None,
+def load_scene(source: Source, *, width: int | None = None, height: int | None = None, samples: int | None = None,
                max_depth: int | None = None, folder: str | os.PathLike | None = None) -> Scene:
     """Read and check a scene: a path (str or os.PathLike), YAML text (a str with a line break, or
     a flow mapping `{...}`) or a dict of the same keys (docs/scene-format.md).
@@ -45,7 +47,7 @@ def load_scene(source, *, width: int | None = None, height: int | None = None, s
     return scene
 
 
-def render(scene, *, width: int | None = None, height: int | None = None, samples: int | None = None,
+def render(scene: Scene | Source, *, width: int | None = None, height: int | None = None, samples: int | None = None,
            max_depth: int | None = None, engine: str = "auto", workers: int | None = None,
            block_size: int = 1, tile: int = TILE, gamma: bool = False, bvh: bool = True,
            linear: bool = False, output: str | os.PathLike | None = None, progress: Progress | None = None,
@@ -83,7 +85,7 @@ def render(scene, *, width: int | None = None, height: int | None = None, sample
     return image
 
 
-def signature(scene, *, width: int | None = None, height: int | None = None, block_size: int = 1,
+def signature(scene: Scene | Source, *, width: int | None = None, height: int | None = None, block_size: int = 1,
               workers: int | None = None, output: str | os.PathLike | None = None) -> ImageArray:
     """The scene signature (notes 000 11.4) as an ImageArray of uint16 (H, W): per pixel the id of
     the first object hit, 0 for the background. It shows as the color-coded picture;
@@ -114,9 +116,8 @@ class LegendRow:
     pixels: int
 
 
-def legend(scene: Scene, ids) -> list[LegendRow]:
+def legend(scene: Scene, ids: np.ndarray) -> list[LegendRow]:
     """The rows of `rtcli signature --legend`: the background (id 0), then every object."""
-    import numpy as np
     counts = np.bincount(np.asarray(ids).ravel(), minlength=len(scene.model.objects) + 1)
     rows = [LegendRow(0, "(background)", "-", int(counts[0]))]
     return rows + [LegendRow(o.id, o.name, o.kind, int(counts[o.id])) for o in scene.model.objects]

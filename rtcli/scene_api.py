@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from rtcli.errors import RtcliError
 from rtcli.scenefile.limits import MAX_SCENE_BYTES
 
-Source = "str | os.PathLike | Mapping"
+Source = str | os.PathLike | Mapping        # what load_scene takes: a path, YAML text or a dict
 PREVIEW = 192                         # a scene's inline preview fits in PREVIEW x PREVIEW pixels
 RANGES = {"width": (1, 32768), "height": (1, 32768), "samples": (1, 16), "max_depth": (1, 64),
           "workers": (1, 256), "block_size": (1, 1024), "tile": (1, 4096)}     # as the command line's
@@ -59,7 +59,7 @@ class Scene:
         return png_bytes(render(self, samples=1, workers=1, **size))
 
 
-def load(source, folder: str | None = None) -> Scene:
+def load(source: Source, folder: str | None = None) -> Scene:
     """The Scene of a path, YAML text or a dict (see rtcli.load_scene for which is which)."""
     from rtcli.scenefile import yamlfile
     from rtcli.scenefile.build import load_scene_and_inputs, scene_from_docs
@@ -84,7 +84,7 @@ def load(source, folder: str | None = None) -> Scene:
     return Scene(model, name, inputs)
 
 
-def is_yaml_text(source) -> bool:
+def is_yaml_text(source: object) -> bool:
     """A str holding a line break, or a flow mapping `{...}`, is YAML text; any other str a path."""
     return isinstance(source, str) and ("\n" in source or source.lstrip().startswith("{"))
 

@@ -20,15 +20,17 @@ import numpy as np
 
 from rtcli.errors import RtcliError
 from rtcli.results import ImageArray
+from rtcli.scene_api import Scene, Source
 
 KINDS = ("depth", "normal", "albedo", "ids")
 
 
-def view(scene, kind: str, *, width: int | None = None, height: int | None = None, tile: int = 128) -> ImageArray:
+def view(scene: Scene | Source, kind: str, *, width: int | None = None, height: int | None = None,
+         tile: int = 128) -> ImageArray:
     """The view `kind` (KINDS) of a Scene, or of what rtcli.load_scene takes, at its size or the one given."""
     from rtcli import api, wavefront
     from rtcli.render import camera_rays
-    from rtcli.scene_api import Scene, check_options, image_size
+    from rtcli.scene_api import check_options, image_size
     from rtcli.wavefront.intersect import find_first_hit, surface
     if kind not in KINDS:
         raise RtcliError(f"the view must be one of {', '.join(KINDS)}, got {kind!r}")
