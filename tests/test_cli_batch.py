@@ -100,3 +100,27 @@ def test_one_scene_keeps_the_stats_line(run):
     assert data["width"] == 32 and data["height"] == 24 and np.isclose(data["total"], data["primary"]
                                                                        + data["shadow"] + data["reflected"]
                                                                        + data["refracted"])
+
+
+def test_an_interrupt_between_scenes_leaves_no_image_and_no_folder(tmp_path):
+    """SIGTERM while the second scene renders: the first scene's staged image and the folder go too."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from test_signals import SLOW
+    (tmp_path / "fast.yaml").write_text(SCENE % "1, 0, 0")
+    (tmp_path / "slow.yaml").write_text(SLOW)
+    proc = subprocess.Popen([sys.executable, "-m", "rtcli", "render", "fast.yaml", "slow.yaml", "-o", "out",
+                             "--engine", "numpy", "--workers", "1"], cwd=tmp_path, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    deadline = time.monotonic() + 60
+    while not list(tmp_path.glob("out/.rtcli-*.png")) and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    time.sleep(0.5)                                    # the slow scene is being traced
+    os.killpg(proc.pid, signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert (proc.returncode, err.decode()) == (143, "error: interrupted\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fast.yaml", "slow.yaml"]
