@@ -12,7 +12,6 @@ import os
 import signal
 import sys
 import threading
-import time
 
 import click
 
@@ -20,7 +19,6 @@ from rtcli import __version__
 from rtcli.errors import Interrupted, RtcliError, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
-INSTALL = "pip install -e '.[{extra}]' in the rtcli folder (rtcli is not on the package index)"
 
 
 def _on_signal(signum, frame):
@@ -105,36 +103,6 @@ def _check_outputs(outputs, inputs) -> None:
     check_outputs(outputs, inputs)
 
 
-def _size(scene, width, height) -> tuple[int, int]:
-    """The image size: the scene's, with --width or --height alone keeping its aspect ratio."""
-    from rtcli.scenefile.build import camera_form, check_image_size
-    sw, sh = scene.settings.width, scene.settings.height
-    w = width or (max(1, round(height * sw / sh)) if height else sw)
-    h = height or (max(1, round(width * sh / sw)) if width else sh)
-    for given, name, other, value in ((width, "--width", "height", h), (height, "--height", "width", w)):
-        if given and value > 32768:
-            raise RtcliError(f"{name} {given} makes the {other} {value} (keeping the scene's {sw}x{sh} "
-                             "aspect ratio), more than 32768")
-    if (why := check_image_size(w, h)) is not None:
-        raise RtcliError(why)
-    form = camera_form(scene)
-    if width and height and w * sh != h * sw and form != "fov":
-        click.echo(f"note: the {form} camera keeps its rectangle, so the {sw}x{sh} scene stretches "
-                   f"to {w}x{h}", err=True)
-    return w, h
-
-
-def _job(scene, width, height, block_size, **kw):
-    from rtcli.render import Job
-    return Job(*_size(scene, width, height), block_size, **kw)
-
-
-def _check_engine(engine: str) -> None:
-    from rtcli import variants
-    if engine == "compiled" and not variants.ENABLED:
-        raise RtcliError(f"--engine compiled needs numba: {INSTALL.format(extra='fast')}")
-
-
 def _progress(enabled: bool, label: str):
     if not enabled:
         return None
@@ -146,10 +114,11 @@ def _progress(enabled: bool, label: str):
 
 
 @main.command()
-@click.argument("scene_file", metavar="SCENE.yaml")
-@click.option("-o", "--output", metavar="OUT.png", callback=_not_empty,
+@click.argument("scene_files", metavar="SCENE.yaml...", nargs=-1, required=True)
+@click.option("-o", "--output", metavar="OUT.png|DIR", callback=_not_empty,
               help="Output image (default: the scene's name .png); the format follows the extension: "
-                   ".png, .jpg, .bmp, .tif, .webp or .ppm.")
+                   ".png, .jpg, .bmp, .tif, .webp or .ppm. With several scenes or a folder: the folder "
+                   "for their images, NAME.png each (default: here).")
 @click.option("--width", type=SIZE, help="Image width (the camera is kept).")
 @click.option("--height", type=SIZE, help="Image height (the camera is kept).")
 @click.option("--block-size", type=click.IntRange(1, 1024), default=1, show_default=True,
@@ -163,32 +132,31 @@ def _progress(enabled: bool, label: str):
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("--progress", is_flag=True, help="Show the progress bar even when stderr is not a terminal.")
 @click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")
+@click.option("--json", "as_json", is_flag=True, help="With --stats: one JSON object per scene, one a line.")
 @click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
               help="numpy core, or compiled integrator (numba); auto: compiled for big jobs it can render.")
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects: test each against every ray (for comparisons).")
-def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
-           gamma, quiet, progress, stats, engine, no_bvh):
-    """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format)."""
-    from rtcli.render import render as render_image
-    from rtcli.writer import write_png
-    start = time.perf_counter()
-    _check_engine(engine)
-    scene, inputs = _load(scene_file)
-    out = _output(scene_file, output)
-    _check_outputs([(out, False)], inputs)
-    if samples:
-        scene.settings.samples = samples
-    if max_depth:
-        scene.settings.max_depth = max_depth
-    job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine, bvh=not no_bvh)
-    show = _progress(not quiet and (progress or sys.stderr.isatty()), one_line(os.path.basename(scene_file)))
-    image, counts = render_image(scene, job, workers or os.cpu_count() or 1, show)
-    write_png(out, image)
-    if stats:
-        seconds = time.perf_counter() - start
-        click.echo(f"rays: {counts.primary} primary, {counts.shadow} shadow, {counts.reflected} reflected, "
-                   f"{counts.refracted} refracted, {counts.total} total; {counts.engine} engine; {seconds:.2f} s; "
-                   f"{counts.total / max(seconds, 1e-9):,.0f} rays/s")
+def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
+           gamma, quiet, progress, stats, as_json, engine, no_bvh):
+    """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format); several
+    scenes, or a folder of them, to a folder of images."""
+    from rtcli import api, batch
+    if as_json and not stats:
+        raise click.UsageError("--json goes with --stats")
+    api.check_engine(engine)
+    items, folder = batch.plan(list(scene_files), output)
+    bar = not quiet and (progress or sys.stderr.isatty())
+    note = lambda text: click.echo(f"note: {text}", err=True)                  # noqa: E731
+
+    def render_one(scene, label):
+        api.image_size(scene.model, width, height, ("--width", "--height"))      # the options' names in errors
+        return api.render(scene, width=width, height=height, engine=engine, workers=workers,
+                          block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh,
+                          progress=_progress(bar, one_line(label)), notes=note)
+    done = batch.run(items, folder, lambda path: api.load_scene(path, samples=samples, max_depth=max_depth),
+                     render_one)
+    for line in batch.stats_lines(done, as_json, folder is not None) if stats else ():
+        click.echo(line)
 
 
 @main.command()
@@ -207,28 +175,23 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
     import numpy as np
 
-    from rtcli.render import render as render_image
+    from rtcli import api
     from rtcli.writer import signature_colors, write_images
-    scene, inputs = _load(scene_file)
-    if len(scene.objects) > 65535:
-        raise RtcliError(f"{shown(scene_file)}: {len(scene.objects)} objects, but signature ids are 16-bit "
-                         "(at most 65535 objects)")
+    scene = api.load_scene(scene_file)
     out = _output(scene_file, output, ".sig.png")
-    _check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), inputs)
-    job = _job(scene, width, height, block_size, signature=True)
-    ids, _ = render_image(scene, job, workers or os.cpu_count() or 1)
-    write_images([(out, signature_colors(ids))] + ([(ids_out, ids)] if ids_out else []))
+    _check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), scene.inputs)
+    api.image_size(scene.model, width, height, ("--width", "--height"))
+    ids = api.signature(scene, width=width, height=height, block_size=block_size, workers=workers)
+    write_images([(out, signature_colors(ids))] + ([(ids_out, np.asarray(ids))] if ids_out else []))
     if legend:
-        counts = np.bincount(ids.ravel(), minlength=len(scene.objects) + 1)
         click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
-        click.echo(f"{0:>5}  {'(background)':<24} {'-':<10} {counts[0]:>9}")
-        for o in scene.objects:
-            click.echo(f"{o.id:>5}  {one_line(o.name) or '-':<24} {o.kind:<10} {counts[o.id]:>9}")
+        for row in api.legend(scene, ids):
+            click.echo(f"{row.id:>5}  {one_line(row.name) or '-':<24} {row.shape:<10} {row.pixels:>9}")
 
 
 @main.command()
-@click.argument("actual", metavar="ACTUAL.png")
-@click.argument("expected", metavar="EXPECTED.png")
+@click.argument("actual", metavar="ACTUAL.png|ACTUAL_DIR")
+@click.argument("expected", metavar="EXPECTED.png|EXPECTED_DIR")
 @click.option("--diff", metavar="DIFF.png", callback=_not_empty, help="Write a heat map of the difference.")
 @click.option("--flip", "flip_out", metavar="FLIP.png", callback=_not_empty,
               help="Also write NVIDIA FLIP's perceptual error map and add its mean to the summary "
@@ -244,16 +207,29 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
 @click.option("--max-boundary-mismatch", type=click.IntRange(0), default=8, show_default=True,
               help="--ids: mismatches allowed on id boundaries (or the fraction below, if larger).")
 @click.option("--max-boundary-fraction", type=click.FloatRange(0, 1), default=0.01, show_default=True)
+@click.option("--report", "report_dir", metavar="DIR", callback=_not_empty,
+              help="Folders: write an HTML report there (index.html and its pictures), worst pair first.")
+@click.option("--junit", "junit_file", metavar="FILE", callback=_not_empty,
+              help="Folders: write the results as JUnit XML, one test case per pair.")
 def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixels, max_bad_fraction,
-            max_cluster, max_boundary_mismatch, max_boundary_fraction):
-    """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it."""
+            max_cluster, max_boundary_mismatch, max_boundary_fraction, report_dir, junit_file):
+    """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it.
+
+    Given two folders, compare every .png in them paired by relative path: exit 0 when every
+    pair passes, 1 when one fails or is missing or extra.
+    """
     from rtcli import compare as cmp
     from rtcli.writer import write_images
-    _check_outputs([(p, False) for p in (diff, flip_out) if p], [actual, expected])
-    a, e = cmp.read_png(actual), cmp.read_png(expected)
     id_options = dict(max_boundary_mismatch=max_boundary_mismatch, max_boundary_fraction=max_boundary_fraction)
     image_options = dict(tolerance=tolerance, max_bad_pixels=max_bad_pixels,
                          max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
+    if _folders(actual, expected, diff or flip_out or ids_mode, report_dir or junit_file):
+        from rtcli.compare_dirs import compare_dirs
+        if not compare_dirs(actual, expected, image_options, id_options, report_dir, junit_file, click.echo):
+            raise click.exceptions.Exit(1)
+        return
+    _check_outputs([(p, False) for p in (diff, flip_out) if p], [actual, expected])
+    a, e = cmp.read_png(actual), cmp.read_png(expected)
     if ids_mode:
         result = cmp.compare_ids(a, e, **id_options)
     else:
@@ -271,6 +247,20 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
     click.echo(summary)
     if not result.ok:
         raise click.exceptions.Exit(1)
+
+
+def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
+    """Whether compare is given two folders; a usage error for a folder and a file, or for options
+    of the other mode."""
+    folders = os.path.isdir(actual), os.path.isdir(expected)
+    if folders[0] != folders[1]:
+        raise click.UsageError(f"{shown(actual if folders[0] else expected)} is a folder: compare two folders "
+                               "or two images")
+    if folders[0] and pair_options:
+        raise click.UsageError("--diff, --flip and --ids compare two images; two folders get --report")
+    if not folders[0] and folder_options:
+        raise click.UsageError("--report and --junit compare two folders")
+    return folders[0]
 
 
 @main.command()
