@@ -1,3 +1,50 @@
-"""rtcli: a command-line Whitted ray tracer driven by YAML scene files."""
+"""rtcli: a Whitted ray tracer driven by YAML scene files, as a command line and a Python API.
+
+    import rtcli
+    image = rtcli.render("scenes/whitted.yaml", width=320)    # a numpy array; shows itself in Jupyter
+
+The API (docs/python-api.md) is imported on first use, so `import rtcli` stays cheap
+for the command line. `rtcli.render` is the API's function; the tile renderer it
+drives is the module of the same name, imported as `from rtcli.render import ...`.
+"""
+
+import sys
+import types
 
 __version__ = "0.1.0"
+
+_EXPORTS = {
+    "load_scene": "rtcli.api", "render": "rtcli.api", "signature": "rtcli.api", "legend": "rtcli.api",
+    "LegendRow": "rtcli.api", "diff": "rtcli.diffs", "Difference": "rtcli.diffs", "Scene": "rtcli.scene_api",
+    "ImageArray": "rtcli.results", "RenderStats": "rtcli.results", "RtcliError": "rtcli.errors",
+    "SceneError": "rtcli.errors", "view": "rtcli.views", "explain": "rtcli.explain",
+}
+__all__ = ["__version__", *_EXPORTS]
+
+
+def __getattr__(name: str):
+    """The API's names, imported when first asked for (PEP 562)."""
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'rtcli' has no attribute {name!r}")
+    import importlib
+    value = getattr(importlib.import_module(_EXPORTS[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list:
+    return sorted(__all__)
+
+
+class _Package(types.ModuleType):
+    """This package, whose API names win over submodules of the same name: importing a submodule
+    sets the package's attribute of that name (rtcli.render the module would hide rtcli.render
+    the function); here that attribute is left to the API. The submodule stays in sys.modules."""
+
+    def __setattr__(self, name, value):
+        if name in _EXPORTS and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

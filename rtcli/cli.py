@@ -1,4 +1,4 @@
-"""The rtcli command line (README.md, Commands): render, signature, compare, validate, presets.
+"""The rtcli command line (README.md, Commands): render, signature, explain, compare, validate, presets.
 
 Argument handling only. Errors from the library (RtcliError) and usage errors
 become one `error: ...` line on stderr with exit code 2; `--debug` shows the
@@ -8,6 +8,7 @@ traceback instead. Ctrl-C (SIGINT) and SIGTERM stop any command at once with
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
@@ -20,7 +21,7 @@ from rtcli import __version__
 from rtcli.errors import Interrupted, RtcliError, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
-INSTALL = "pip install -e '.[{extra}]' in the rtcli folder (rtcli is not on the package index)"
+VIEWS = ("normal", "depth", "uv", "albedo", "bounces", "ids")          # rtcli/views.py, not imported to start
 
 
 def _on_signal(signum, frame):
@@ -84,6 +85,15 @@ def main(debug):
     # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
+def _load(path: str, frame: int | None = None, keep: bool = False, **overrides):
+    """(frames.Loaded, api.Scene) of a scene file at frame `frame` (default 1), with the command
+    line's overrides; `keep`: also the files' bytes, for a cluster."""
+    from rtcli.frames import load
+    from rtcli.scene_api import of_loaded
+    loaded = load(path, frame, keep=keep)
+    return loaded, of_loaded(loaded, path).override(**overrides)
+
+
 def _not_empty(ctx, param, value):
     if value is not None and not value.strip():
         raise click.BadParameter("must not be empty", ctx, param)
@@ -97,36 +107,6 @@ def _output(scene_path: str, out: str | None, suffix: str = ".png") -> str:
 def _check_outputs(outputs, inputs) -> None:
     from rtcli.outputs import check_outputs
     check_outputs(outputs, inputs)
-
-
-def _size(scene, width, height) -> tuple[int, int]:
-    """The image size: the scene's, with --width or --height alone keeping its aspect ratio."""
-    from rtcli.scenefile.build import camera_form, check_image_size
-    sw, sh = scene.settings.width, scene.settings.height
-    w = width or (max(1, round(height * sw / sh)) if height else sw)
-    h = height or (max(1, round(width * sh / sw)) if width else sh)
-    for given, name, other, value in ((width, "--width", "height", h), (height, "--height", "width", w)):
-        if given and value > 32768:
-            raise RtcliError(f"{name} {given} makes the {other} {value} (keeping the scene's {sw}x{sh} "
-                             "aspect ratio), more than 32768")
-    if (why := check_image_size(w, h)) is not None:
-        raise RtcliError(why)
-    form = camera_form(scene)
-    if width and height and w * sh != h * sw and form != "fov":
-        click.echo(f"note: the {form} camera keeps its rectangle, so the {sw}x{sh} scene stretches "
-                   f"to {w}x{h}", err=True)
-    return w, h
-
-
-def _job(scene, width, height, block_size, **kw):
-    from rtcli.render import Job
-    return Job(*_size(scene, width, height), block_size, **kw)
-
-
-def _check_engine(engine: str) -> None:
-    from rtcli import variants
-    if engine == "compiled" and not variants.ENABLED:
-        raise RtcliError(f"--engine compiled needs numba: {INSTALL.format(extra='fast')}")
 
 
 def _progress(enabled: bool, label: str):
@@ -154,19 +134,31 @@ def _cluster_options(command):
 
 
 def _cluster(address, file, local):
-    """The cluster the options name, or None; rtcli.cluster (and Dask) only when one is named."""
+    """The cluster the options name (a frames.Reach, to use in a `with` block), or None; rtcli.cluster
+    (and Dask) only when one is named."""
     if not (address or file or local):
         return None
     from rtcli.cluster import target
-    return target(address, file, local)
+    from rtcli.frames import Reach
+    return Reach(target(address, file, local))
+
+
+def _size(model, width, height) -> tuple[int, int]:
+    """The image size of a scene's model (api.image_size with the options' names), its note printed."""
+    from rtcli import api
+    w, h, note = api.image_size(model, width, height, ("--width", "--height"))
+    if note:
+        click.echo(f"note: {note}", err=True)
+    return w, h
 
 
 @main.command()
-@click.argument("scene_file", metavar="SCENE.yaml")
-@click.option("-o", "--output", metavar="OUT.png", callback=_not_empty,
+@click.argument("scene_files", metavar="SCENE.yaml...", nargs=-1, required=True)
+@click.option("-o", "--output", metavar="OUT.png|DIR", callback=_not_empty,
               help="Output image (default: the scene's name .png); the format follows the extension: "
                    ".png, .jpg, .bmp, .tif, .webp or .ppm. Frames: a name with the frame number as %d "
-                   "(out/frame_%04d.png); a movie: .apng or .gif.")
+                   "(out/frame_%04d.png); a movie: .apng or .gif. With several scenes or a folder: the "
+                   "folder for their images, NAME.png each (default: here).")
 @click.option("--width", type=SIZE, help="Image width (the camera is kept).")
 @click.option("--height", type=SIZE, help="Image height (the camera is kept).")
 @click.option("--block-size", type=click.IntRange(1, 1024), default=1, show_default=True,
@@ -180,51 +172,135 @@ def _cluster(address, file, local):
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("--progress", is_flag=True, help="Show the progress bar even when stderr is not a terminal.")
 @click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")
+@click.option("--json", "as_json", is_flag=True, help="With --stats: one JSON object per scene, one a line.")
 @click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
               help="numpy core, or compiled integrator (numba); auto: compiled for big jobs it can render.")
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects: test each against every ray (for comparisons).")
+@click.option("--view", type=click.Choice(VIEWS), help="Write a debug view instead of the image (default name "
+              "NAME.VIEW.png): outward normals, depth, uv, albedo (kd T), bounces or the signature ids.")
 @click.option("--frames", "frame_range", metavar="FIRST-LAST",
               help="Render these frames of an animated scene (default with a frame pattern or a movie: all).")
 @click.option("--frame", type=click.IntRange(1), metavar="N", help="Render frame N of an animated scene (default 1).")
 @click.option("--movie", metavar="MOVIE.apng", callback=_not_empty,
               help="Also write the frames as an animated PNG (.apng) or GIF (.gif).")
-@click.option("--skip-existing", is_flag=True, help="Leave the frames (or image) already written; render the rest.")
+@click.option("--skip-existing", is_flag=True, help="Leave the frames (or images) already written; render the rest.")
 @_cluster_options
-def render(scene_file, output, width, height, block_size, samples, max_depth, workers, tile,
-           gamma, quiet, progress, stats, engine, no_bvh, frame_range, frame, movie, skip_existing,
+def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
+           gamma, quiet, progress, stats, as_json, engine, no_bvh, view, frame_range, frame, movie, skip_existing,
            cluster, cluster_file, local_cluster):
-    """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames."""
+    """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
+    several scenes, or a folder of them, to a folder of images."""
+    from rtcli import api, batch
     from rtcli import frames as animation
-    from rtcli.writer import write_png
-    start = time.perf_counter()
-    _check_engine(engine)
+    from rtcli.movie import is_movie
+    if as_json and not stats:
+        raise click.UsageError("--json goes with --stats")
+    if view and stats:
+        raise click.UsageError("--stats counts the rays of a render, not of a --view")
+    sequence = animation.wants_sequence(output, frame_range, movie)
+    several = len(scene_files) > 1 or os.path.isdir(scene_files[0])
+    if several and (frame_range or movie or is_movie(output)):
+        raise click.UsageError("--frames and movies render one animated scene, not several (--frame N "
+                               "renders frame N of each)")
+    if view and sequence and not several:
+        raise click.UsageError("--view writes one picture: give --frame N, not --frames, a frame pattern "
+                               "or a movie")
+    if view and (cluster or cluster_file or local_cluster):
+        raise click.UsageError("--view is computed on this machine: it takes no cluster option")
+    api.check_engine(engine)
     where = _cluster(cluster, cluster_file, local_cluster)
-    several = animation.wants_sequence(output, frame_range, movie)
-    loaded = animation.load(scene_file, None if several else frame, keep=where is not None)
-    scene, inputs, changes = loaded.scene, loaded.inputs, animation.overrides(samples, max_depth)
-    if several:
-        seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
-        outs = [(p, False) for p in seq.paths.values()] + [(m, "movie") for m in seq.movies]
-    else:
-        out = _output(scene_file, output)
-        outs = [(out, False)]
-    _check_outputs(outs, inputs)
-    animation.apply(scene, changes)
-    job = _job(scene, width, height, block_size, tile=tile, gamma=gamma, engine=engine, bvh=not no_bvh)
-    show = _progress(not quiet and (progress or sys.stderr.isatty()), one_line(os.path.basename(scene_file)))
-    if several:
-        counts = animation.render_sequence(loaded, seq, job, workers or os.cpu_count() or 1, changes,
-                                           skip_existing, show, where)
-    elif skip_existing and os.path.isfile(out):
+    bar = not quiet and (progress or sys.stderr.isatty())
+    with where or contextlib.nullcontext():
+        if sequence and not several:
+            job = dict(width=width, height=height, block_size=block_size, tile=tile, gamma=gamma, engine=engine,
+                       bvh=not no_bvh)
+            shown_stats = ("json" if as_json else "line") if stats else None
+            return _render_frames(scene_files[0], output, frame_range, frame, movie, skip_existing, where, job,
+                                  animation.overrides(samples, max_depth), workers, bar, shown_stats)
+        items, folder = batch.plan(list(scene_files), output, f".{view}.png" if view else ".png")
+        if skip_existing:
+            items = [item for item in items if not os.path.isfile(item.output)]
+        note = lambda text: click.echo(f"note: {text}", err=True)                  # noqa: E731
+        current = {}
+
+        def load(path):
+            current["loaded"], scene = _load(path, frame, where is not None, samples=samples, max_depth=max_depth)
+            return scene
+
+        def render_one(scene, label):
+            api.image_size(scene.model, width, height, ("--width", "--height"))      # the options' names in errors
+            show = _progress(bar, one_line(label))
+            if view:
+                return _view(scene, view, width, height, tile, label if folder is not None else None)
+            if where is not None:
+                return _on_cluster(current["loaded"], scene, where, dict(samples=samples, max_depth=max_depth),
+                                   width, height, block_size, tile=tile, gamma=gamma, engine=engine,
+                                   bvh=not no_bvh, progress=show)
+            return api.render(scene, width=width, height=height, engine=engine, workers=workers,
+                              block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh,
+                              progress=show, notes=note)
+        done = batch.run(items, folder, load, render_one) if items else []
+    for line in batch.stats_lines(done, as_json, folder is not None) if stats else ():
+        click.echo(line)
+
+
+def _job(model, width, height, block_size, **kw):
+    from rtcli.render import Job
+    return Job(*_size(model, width, height), block_size, **kw)
+
+
+def _on_cluster(loaded, scene, where, changes: dict, width, height, block_size, progress=None, **kw):
+    """The still (frames.render_image) of `loaded` traced on the cluster, as api.render returns it."""
+    from rtcli.frames import overrides, render_image
+    from rtcli.results import ImageArray, RenderStats
+    job = _job(scene.model, width, height, block_size, **kw)
+    start = time.perf_counter()
+    pixels, counts = render_image(loaded, job, 1, progress, where, overrides(**changes))
+    s = scene.model.settings
+    stats = RenderStats(job.width, job.height, 1 if job.signature else s.samples, counts.engine, counts.primary,
+                        counts.shadow, counts.reflected, counts.refracted, time.perf_counter() - start)
+    return ImageArray(pixels, stats, scene.inputs)
+
+
+def _render_frames(scene_file: str, output, frame_range, frame, movie, skip_existing: bool, where, job: dict,
+                   changes: dict, workers, bar: bool, stats) -> None:
+    """An animation's frames to files or movies (frames.py), each file written as its frame is done;
+    `stats`: None, "line" or "json"."""
+    import json
+
+    from rtcli import frames as animation
+    from rtcli.results import RenderStats
+    start = time.perf_counter()
+    loaded = animation.load(scene_file, None, keep=where is not None)
+    scene = loaded.scene
+    seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
+    _check_outputs([(p, False) for p in seq.paths.values()] + [(m, "movie") for m in seq.movies], loaded.inputs)
+    animation.apply(scene, changes)            # the other frames are checked as written, then changed alike
+    size = job.pop("width"), job.pop("height"), job.pop("block_size")
+    job = _job(scene, *size, **job)
+    show = _progress(bar, one_line(os.path.basename(scene_file)))
+    todo, rendering = animation.to_render(seq, skip_existing), time.perf_counter()
+    counts = animation.render_sequence(loaded, seq, job, workers or os.cpu_count() or 1, changes, skip_existing,
+                                       show, where)
+    if not stats:
         return
+    done = RenderStats(job.width, job.height, scene.settings.samples, counts.engine or "none", counts.primary,
+                       counts.shadow, counts.reflected, counts.refracted, time.perf_counter() - rendering)
+    seconds = time.perf_counter() - start
+    if stats == "json":
+        click.echo(json.dumps({"scene": scene_file, "frames": todo, **done.as_dict(),
+                               "wall_seconds": round(seconds, 6)}))
     else:
-        image, counts = animation.render_image(loaded, job, workers or os.cpu_count() or 1, show, where, changes)
-        write_png(out, image)
-    if stats:
-        seconds = time.perf_counter() - start
-        click.echo(f"rays: {counts.primary} primary, {counts.shadow} shadow, {counts.reflected} reflected, "
-                   f"{counts.refracted} refracted, {counts.total} total; {counts.engine} engine; {seconds:.2f} s; "
-                   f"{counts.total / max(seconds, 1e-9):,.0f} rays/s")
+        click.echo(done.line(seconds))
+
+
+def _view(scene, kind: str, width, height, tile: int, label: str | None):
+    """A debug view's picture (rtcli/views.py), its summary line printed."""
+    from rtcli.results import ImageArray
+    from rtcli.views import summary, view
+    data = view(scene, kind, width=width, height=height, tile=tile)
+    click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
+    return ImageArray(data.to_8bit(), inputs=scene.inputs)
 
 
 @main.command()
@@ -246,30 +322,74 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
     import numpy as np
 
-    from rtcli.frames import load, render_image
+    from rtcli import api
     from rtcli.writer import signature_colors, write_images
     where = _cluster(cluster, cluster_file, local_cluster)
-    loaded = load(scene_file, frame, keep=where is not None)
-    scene, inputs = loaded.scene, loaded.inputs
-    if len(scene.objects) > 65535:
-        raise RtcliError(f"{shown(scene_file)}: {len(scene.objects)} objects, but signature ids are 16-bit "
-                         "(at most 65535 objects)")
+    loaded, scene = _load(scene_file, frame, keep=where is not None)
     out = _output(scene_file, output, ".sig.png")
-    _check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), inputs)
-    job = _job(scene, width, height, block_size, signature=True)
-    ids, _ = render_image(loaded, job, workers or os.cpu_count() or 1, where=where)
-    write_images([(out, signature_colors(ids))] + ([(ids_out, ids)] if ids_out else []))
+    _check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), scene.inputs)
+    api.image_size(scene.model, width, height, ("--width", "--height"))
+    if where is None:
+        ids = api.signature(scene, width=width, height=height, block_size=block_size, workers=workers)
+    else:
+        api.check_ids(scene)
+        with where:
+            ids = _on_cluster(loaded, scene, where, dict(samples=None, max_depth=None), width, height, block_size,
+                              signature=True)
+    write_images([(out, signature_colors(ids))] + ([(ids_out, np.asarray(ids))] if ids_out else []))
     if legend:
-        counts = np.bincount(ids.ravel(), minlength=len(scene.objects) + 1)
         click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
-        click.echo(f"{0:>5}  {'(background)':<24} {'-':<10} {counts[0]:>9}")
-        for o in scene.objects:
-            click.echo(f"{o.id:>5}  {one_line(o.name) or '-':<24} {o.kind:<10} {counts[o.id]:>9}")
+        for row in api.legend(scene, ids):
+            click.echo(f"{row.id:>5}  {one_line(row.name) or '-':<24} {row.shape:<10} {row.pixels:>9}")
+
+
+@main.command(context_settings={"ignore_unknown_options": True})       # a negative X or Y is a pixel, not an option
+@click.argument("scene_file", metavar="SCENE.yaml")
+@click.argument("x", type=int)
+@click.argument("y", type=int)
+@click.option("--width", type=SIZE, help="Image width (the camera is kept), as given to render.")
+@click.option("--height", type=SIZE, help="Image height (the camera is kept), as given to render.")
+@click.option("--samples", type=click.IntRange(1, 16), help="N x N samples per pixel, as given to render.")
+@click.option("--max-depth", type=click.IntRange(1, 64), help="Rays per path, as given to render.")
+@click.option("--sample", "sample", type=click.IntRange(0), metavar="K",
+              help="With N x N samples: show sample K (0 to N*N-1, row by row; default 0).")
+@click.option("--all-samples", is_flag=True, help="With N x N samples: show every sample's tree.")
+@click.option("--json", "as_json", is_flag=True, help="Print the trees as JSON (every sample unless --sample).")
+@click.option("--gamma", is_flag=True, help="The 8-bit value sRGB-encoded, as render --gamma writes it.")
+@click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects, as render --no-bvh.")
+@click.option("--frame", type=click.IntRange(1), metavar="N", help="Frame N of an animated scene (default 1).")
+def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_samples, as_json, gamma, no_bvh, frame):
+    """Explain why pixel (X, Y) has its color: its ray tree, every term of the shading equation
+    with its numbers, and the sum at every ray (X from the left, Y from the top, from 0)."""
+    from rtcli import api
+    from rtcli.explain import explain as explain_pixel
+    if sample is not None and all_samples:
+        raise click.UsageError("--sample and --all-samples go one at a time")
+    _, scene = _load(scene_file, frame)
+    api.image_size(scene.model, width, height, ("--width", "--height"))          # the options' names in errors
+    scene.override(width=width, height=height)
+    e = explain_pixel(scene, x, y, samples=samples, max_depth=max_depth, gamma=gamma, bvh=not no_bvh)
+    if sample is not None and sample >= e.samples ** 2:
+        raise click.BadParameter(f"{sample} is not a sample of this pixel: it has {e.samples ** 2} "
+                                 f"(0 to {e.samples ** 2 - 1})", param_hint="'--sample'")
+    if as_json:
+        click.echo(e.json(sample))
+        return
+    color = "NO_COLOR" not in os.environ and None                    # None: click colors only a terminal
+    click.echo(e.text(None if all_samples else sample or 0, _style), color=color)
+
+
+_STYLE_OF = {"ray": dict(fg="cyan", bold=True), "miss": dict(fg="yellow"), "sum": dict(bold=True),
+             "note": dict(dim=True), "term": {}}
+
+
+def _style(text: str, role: str) -> str:
+    return click.style(text, **_STYLE_OF[role])
 
 
 @main.command()
-@click.argument("actual", metavar="ACTUAL.png")
-@click.argument("expected", metavar="EXPECTED.png")
+@click.argument("actual", metavar="ACTUAL.png|ACTUAL_DIR")
+@click.argument("expected", metavar="EXPECTED.png|EXPECTED_DIR")
 @click.option("--diff", metavar="DIFF.png", callback=_not_empty, help="Write a heat map of the difference.")
 @click.option("--flip", "flip_out", metavar="FLIP.png", callback=_not_empty,
               help="Also write NVIDIA FLIP's perceptual error map and add its mean to the summary "
@@ -285,16 +405,29 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
 @click.option("--max-boundary-mismatch", type=click.IntRange(0), default=8, show_default=True,
               help="--ids: mismatches allowed on id boundaries (or the fraction below, if larger).")
 @click.option("--max-boundary-fraction", type=click.FloatRange(0, 1), default=0.01, show_default=True)
+@click.option("--report", "report_dir", metavar="DIR", callback=_not_empty,
+              help="Folders: write an HTML report there (index.html and its pictures), worst pair first.")
+@click.option("--junit", "junit_file", metavar="FILE", callback=_not_empty,
+              help="Folders: write the results as JUnit XML, one test case per pair.")
 def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixels, max_bad_fraction,
-            max_cluster, max_boundary_mismatch, max_boundary_fraction):
-    """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it."""
+            max_cluster, max_boundary_mismatch, max_boundary_fraction, report_dir, junit_file):
+    """Compare two PNGs' pixels; exit 0 within tolerance, 1 beyond it.
+
+    Given two folders, compare every .png in them paired by relative path: exit 0 when every
+    pair passes, 1 when one fails or is missing or extra.
+    """
     from rtcli import compare as cmp
     from rtcli.writer import write_images
-    _check_outputs([(p, False) for p in (diff, flip_out) if p], [actual, expected])
-    a, e = cmp.read_png(actual), cmp.read_png(expected)
     id_options = dict(max_boundary_mismatch=max_boundary_mismatch, max_boundary_fraction=max_boundary_fraction)
     image_options = dict(tolerance=tolerance, max_bad_pixels=max_bad_pixels,
                          max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
+    if _folders(actual, expected, diff or flip_out or ids_mode, report_dir or junit_file):
+        from rtcli.compare_dirs import compare_dirs
+        if not compare_dirs(actual, expected, image_options, id_options, report_dir, junit_file, click.echo):
+            raise click.exceptions.Exit(1)
+        return
+    _check_outputs([(p, False) for p in (diff, flip_out) if p], [actual, expected])
+    a, e = cmp.read_png(actual), cmp.read_png(expected)
     if ids_mode:
         result = cmp.compare_ids(a, e, **id_options)
     else:
@@ -314,10 +447,24 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
         raise click.exceptions.Exit(1)
 
 
+def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
+    """Whether compare is given two folders; a usage error for a folder and a file, or for options
+    of the other mode."""
+    folders = os.path.isdir(actual), os.path.isdir(expected)
+    if folders[0] != folders[1]:
+        raise click.UsageError(f"{shown(actual if folders[0] else expected)} is a folder: compare two folders "
+                               "or two images")
+    if folders[0] and pair_options:
+        raise click.UsageError("--diff, --flip and --ids compare two images; two folders get --report")
+    if not folders[0] and folder_options:
+        raise click.UsageError("--report and --junit compare two folders")
+    return folders[0]
+
+
 @main.command()
 @click.argument("scene_file", metavar="SCENE.yaml")
 def validate(scene_file):
-    """Parse and check a scene; print a summary. Renders nothing."""
+    """Parse and check a scene, every frame of an animated one; print a summary. Renders nothing."""
     from rtcli.frames import load
     from rtcli.scenefile.build import summary
     loaded = load(scene_file)

@@ -6,18 +6,21 @@ import re
 from dataclasses import dataclass
 
 _PLAIN = re.compile(r"[\w./+@%,=:~-]+", re.ASCII)       # shown without quotes
+SOURCES = ("<string>", "<dict>")     # how scenes given to the Python API as YAML text or a dict are named
 
 
 @dataclass(frozen=True, slots=True)
 class Where:
-    """A place in a scene file: 1-based line and column."""
+    """A place in a scene file: 1-based line and column; line 0 for a scene given as a dict,
+    which only its key path locates."""
 
     file: str
     line: int
     column: int
 
     def __str__(self) -> str:
-        return f"{shown(self.file)}:{self.line}:{self.column}"
+        name = self.file if self.file in SOURCES else shown(self.file)
+        return f"{name}:{self.line}:{self.column}" if self.line else name
 
 
 def quoted(text) -> str:

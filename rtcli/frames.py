@@ -20,9 +20,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli import render as renderer
 from rtcli.errors import RtcliError, shown
 from rtcli.movie import check_size, is_movie, movie_format, write_movie
+from rtcli.render import blank, place, plan
+from rtcli.render import render as render_tiles  # `from rtcli import render` is the API function
 from rtcli.scenefile.animation import Animation, load_animation
 from rtcli.stats import Stats
 from rtcli.writer import write_png
@@ -42,8 +43,10 @@ class Loaded:
     bundle: object = None
 
 
-def load(scene_file: str, frame: int | None = None, keep: bool = False) -> Loaded:
-    """The scene file with frame `frame` (default 1) built; `keep`: also the files' bytes."""
+def load(scene_file: str, frame: int | None = None, keep: bool = False, option: str = "--frame") -> Loaded:
+    """The scene file with frame `frame` (default 1) built; `keep`: also the files' bytes;
+    `option` names the frame in messages."""
+    from rtcli.scene_api import check_frame
     from rtcli.scenefile.files import collecting
     with collecting() if keep else contextlib.nullcontext() as kept:
         animation, first, inputs = load_animation(scene_file)
@@ -52,8 +55,7 @@ def load(scene_file: str, frame: int | None = None, keep: bool = False) -> Loade
         from rtcli.cluster import Bundle
         bundle = Bundle.of(scene_file, kept)
     k = frame or 1
-    if not 1 <= k <= animation.frames:
-        raise RtcliError(f"--frame {k}: {_frames_of(animation, scene_file)}")
+    check_frame(animation, k, scene_file, option)
     return Loaded(animation, first if k == 1 else animation.scene(k), k, inputs, bundle)
 
 
@@ -74,19 +76,52 @@ def apply(scene, changes: dict):
     return scene
 
 
+# --- the cluster ---
+class Reach:
+    """The cluster of one command (a cluster.Target), connected when a render first needs it and
+    closed at the end of the `with` block: the scenes of a run share one connection (and one
+    --local-cluster), and a run with nothing to render reaches no cluster."""
+
+    def __init__(self, target):
+        self.target, self._session, self._stack = target, None, contextlib.ExitStack()
+
+    def session(self):
+        if self._session is None:
+            from rtcli.cluster import Session
+            self._session = self._stack.enter_context(Session(self.target))
+        return self._session
+
+    def __enter__(self) -> Reach:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stack.close()
+
+
+@contextlib.contextmanager
+def _session(where):
+    """The session of `where`: a Reach's shared one, or one opened for the block (a cluster.Target)."""
+    if isinstance(where, Reach):
+        yield where.session()
+        return
+    from rtcli.cluster import Session
+    with Session(where) as session:
+        yield session
+
+
 # --- one image ---
 def render_image(loaded: Loaded, job, workers: int, progress=None, where=None, changes: dict | None = None):
-    """The image (or ids) of the loaded frame: on this machine's cores, or on the cluster `where`."""
+    """The image (or ids) of the loaded frame: on this machine's cores, or on the cluster `where`
+    (a cluster.Target, or a Reach)."""
     if where is None:
-        return renderer.render(loaded.scene, job, workers, progress)
-    from rtcli.cluster import Session
-    image, stats = renderer.blank(job), Stats()
-    tiles, traced = renderer.plan(loaded.scene, job)
-    with Session(where) as session:
+        return render_tiles(loaded.scene, job, workers, progress)
+    image, stats = blank(job), Stats()
+    tiles, traced = plan(loaded.scene, job)
+    with _session(where) as session:
         results = session.tiles(loaded.bundle, changes or {}, loaded.frame, job, traced, tiles,
                                 1 if job.signature else loaded.scene.settings.samples)
         for done, (rows, cols, values, s) in enumerate(results, 1):
-            renderer.place(image, job, rows, cols, values)
+            place(image, job, rows, cols, values)
             stats.add(s)
             stats.engine = s.engine
             if progress:
@@ -147,11 +182,16 @@ def _range(text: str | None, animation: Animation, scene_file: str) -> list[int]
     return list(range(first, last + 1))
 
 
+def to_render(seq: Sequence, skip_existing: bool) -> list[int]:
+    """The sequence's frames to render: all, or with `skip_existing` those whose files are missing."""
+    return [k for k in seq.frames if not (skip_existing and k in seq.paths and os.path.isfile(seq.paths[k]))]
+
+
 def render_sequence(loaded: Loaded, seq: Sequence, job, workers: int, changes: dict, skip_existing: bool,
                     progress=None, where=None) -> Stats:
     """Render the sequence's frames, writing each file as its frame is done and the movies at the
     end; frames whose files exist are skipped with `skip_existing` (read back for a movie)."""
-    todo = [k for k in seq.frames if not (skip_existing and k in seq.paths and os.path.isfile(seq.paths[k]))]
+    todo = to_render(seq, skip_existing)
     if seq.movies:
         check_size(len(seq.frames), job.width, job.height)
     for k in todo:
@@ -174,8 +214,7 @@ def render_sequence(loaded: Loaded, seq: Sequence, job, workers: int, changes: d
 def _frames(loaded: Loaded, todo: list[int], job, workers: int, changes: dict, progress, where):
     """(frame, image, stats) of each frame to do: here one after another, or on the cluster as they finish."""
     if where is not None:
-        from rtcli.cluster import Session
-        with Session(where) as session:
+        with _session(where) as session:
             for done, result in enumerate(session.frames(loaded.bundle, changes, todo, job), 1):
                 if progress:
                     progress(done, len(todo))
@@ -184,7 +223,7 @@ def _frames(loaded: Loaded, todo: list[int], job, workers: int, changes: dict, p
     for i, k in enumerate(todo):
         scene = loaded.scene if k == loaded.frame else apply(loaded.animation.scene(k), changes)
         step = None if progress is None else (lambda done, total, i=i: progress(i * total + done, len(todo) * total))
-        image, s = renderer.render(scene, job, workers, step)
+        image, s = render_tiles(scene, job, workers, step)
         yield k, image, s
 
 

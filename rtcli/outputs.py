@@ -25,12 +25,7 @@ def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> N
     reals = {os.path.realpath(p) for p in inputs}
     for path, ids in outputs:
         real = os.path.realpath(path)
-        if real in reals or _identity(path) in known:
-            raise RtcliError(f"{shown(path)}: is an input of this run; it will not be overwritten "
-                             "(choose another output name)")
-        _check_replaceable(path)
-        if not os.path.isdir(os.path.dirname(os.path.abspath(path))):
-            raise RtcliError(f"{shown(path)}: output folder does not exist")
+        _check_file(path, reals, known)
         if ids == "movie":
             from rtcli.movie import movie_format
             movie_format(path)
@@ -39,6 +34,20 @@ def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> N
         if real in seen:
             raise RtcliError(f"{shown(path)}: given for two outputs; they must differ")
         seen[real] = path
+
+
+def check_file_output(path: str, inputs: list[str]) -> None:
+    """The checks of check_outputs for an output that is not an image (a JUnit XML file)."""
+    _check_file(path, {os.path.realpath(p) for p in inputs}, {_identity(p) for p in inputs} - {None})
+
+
+def _check_file(path: str, reals: set, known: set) -> None:
+    if os.path.realpath(path) in reals or _identity(path) in known:
+        raise RtcliError(f"{shown(path)}: is an input of this run; it will not be overwritten "
+                         "(choose another output name)")
+    _check_replaceable(path)
+    if not os.path.isdir(os.path.dirname(os.path.abspath(path))):
+        raise RtcliError(f"{shown(path)}: output folder does not exist")
 
 
 def _check_replaceable(path: str) -> None:

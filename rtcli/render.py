@@ -46,6 +46,7 @@ class Job:
     gamma: bool = False              # sRGB-encode when converting to 8 bits
     engine: str = "auto"             # auto, numpy or compiled (see rtcli.compiled.choose)
     bvh: bool = True                 # a BVH over the scene's objects when there are enough (Scene.wants_bvh)
+    linear: bool = False             # keep the traced colors (float64, unclamped) instead of 8 bits
 
 
 def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -110,7 +111,7 @@ def _run_tile(scene: Scene, engine, job: Job, rows: np.ndarray, cols: np.ndarray
     """A tile's 8-bit pixels (or ids), small enough to pile up while the parent catches up."""
     jj, ii = np.meshgrid(rows, cols, indexing="ij")
     values, stats = render_tile(scene, job, ii.ravel(), jj.ravel(), engine)
-    if not job.signature:
+    if not (job.signature or job.linear):
         values = to_8bit(values, job.gamma)
     return rows, cols, values.reshape(len(rows), len(cols), *values.shape[1:]), stats
 
@@ -129,10 +130,11 @@ def _worker_tile(job: Job, rows, cols):
 
 
 def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.ndarray, Stats]:
-    """The 8-bit image (H, W, 3), or the id map (H, W) uint16 for a signature.
+    """The 8-bit image (H, W, 3), or the id map (H, W) uint16 for a signature, or with
+    job.linear the float64 colors (H, W, 3).
 
     Each tile is converted to 8 bits where it is traced, so no float copy of the
-    whole image ever exists.
+    whole image ever exists unless job.linear asks for one.
     """
     image, (tiles, traced) = blank(job), plan(scene, job)
     stats, engine = Stats(), prepare(scene, job, traced)
@@ -147,9 +149,10 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.
 
 
 def blank(job: Job) -> np.ndarray:
-    """The job's image before any tile is placed: 8-bit RGB, or 16-bit ids for a signature."""
+    """The job's image before any tile is placed: 8-bit RGB, 16-bit ids for a signature, or
+    float64 colors with job.linear."""
     shape = (job.height, job.width) + (() if job.signature else (3,))
-    return np.zeros(shape, dtype=np.uint16 if job.signature else np.uint8)
+    return np.zeros(shape, dtype=np.uint16 if job.signature else np.float64 if job.linear else np.uint8)
 
 
 def plan(scene: Scene, job: Job) -> tuple[list, int]:

@@ -68,22 +68,44 @@ def write_images(items: list[tuple[str, np.ndarray]]) -> None:
     extension, all or none: every image goes to a temporary file in its folder first, and
     only when all are written are they renamed into place; on any failure, or an
     interrupt, the temporary files and any image already renamed are removed."""
-    temps, placed = [], []
-    try:
+    with Staged() as staged:
         for path, pixels in items:
-            temps.append((_write_temp(path, pixels), path))
-        for tmp, path in temps:
-            os.replace(tmp, path)
-            placed.append(path)
-    except BaseException as e:
-        for tmp, _ in temps:
+            staged.add(path, pixels)
+        staged.commit()
+
+
+class Staged:
+    """Images written to temporary files one at a time and renamed into place together by
+    commit(), all or none: a run that renders several images one after another holds
+    only one in memory. Leaving the `with` block without commit() removes them all."""
+
+    def __init__(self):
+        self.temps: list[tuple[str, str]] = []     # (temporary file, final path)
+        self.placed: list[str] = []
+
+    def __enter__(self) -> "Staged":
+        return self
+
+    def add(self, path: str, pixels: np.ndarray) -> None:
+        try:
+            self.temps.append((_write_temp(path, pixels), path))
+        except OSError as e:
+            raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
+
+    def commit(self) -> None:
+        try:
+            for tmp, path in self.temps:
+                os.replace(tmp, path)
+                self.placed.append(path)
+        except OSError as e:
+            raise RtcliError(f"cannot write {shown(self.temps[len(self.placed)][1])}: {e.strerror or e}") from None
+        self.temps, self.placed = [], []               # in place: nothing left to undo
+
+    def __exit__(self, kind, error, trace) -> None:
+        for tmp, _ in self.temps:
             _remove(tmp)
-        for path in placed:
+        for path in self.placed:
             _remove(path)
-        if isinstance(e, OSError):
-            failed = items[len(placed) if len(temps) == len(items) else len(temps)][0]
-            raise RtcliError(f"cannot write {shown(failed)}: {e.strerror or e}") from None
-        raise
 
 
 def _write_temp(path: str, pixels: np.ndarray) -> str:
@@ -101,7 +123,7 @@ def _write_temp(path: str, pixels: np.ndarray) -> str:
     try:
         with os.fdopen(fd, "wb") as f:
             img.save(f, format=fmt, **options)
-        os.chmod(tmp, 0o666 & ~_umask())               # as a plain open() would (mkstemp makes 0600)
+        os.chmod(tmp, 0o666 & ~current_umask())               # as a plain open() would (mkstemp makes 0600)
     except BaseException:
         _remove(tmp)
         raise
@@ -115,7 +137,8 @@ def _remove(path: str) -> None:
         pass
 
 
-def _umask() -> int:
+def current_umask() -> int:
+    """The process's umask (read by setting it and back), for files made by mkstemp, which are 0600."""
     mask = os.umask(0)
     os.umask(mask)
     return mask

@@ -246,3 +246,21 @@ def test_a_scheduler_without_workers_is_named(run, tmp_path):
                                 "(start some: README.md, Clusters)")
     finally:
         empty.close()
+
+
+def test_several_scenes_on_the_cluster_are_the_local_renders_all_placed_or_none(run, tmp_path, cluster):
+    """A folder's scenes share one connection; their images are staged and placed together."""
+    (tmp_path / "more.yaml").write_text(SCENE.replace("eye: [0, 1.5, 5]", "eye: [1, 2, 5]"))
+    for name in ("scene", "more"):
+        assert run("render", f"{name}.yaml", "--frame", "3", "-o", f"{name}-local.png").exit_code == 0
+    result = run("render", "scene.yaml", "more.yaml", "--frame", "3", "-o", "out", "--stats",
+                 "--cluster", cluster.scheduler_address)
+    assert result.exit_code == 0, result.output
+    assert [line.split(": rays: ")[0] for line in result.output.splitlines()] == ["scene.yaml", "more.yaml"]
+    for name in ("scene", "more"):
+        assert same_files(tmp_path, f"{name}-local.png", f"out/{name}.png"), name
+    (tmp_path / "bad.yaml").write_text(SCENE.replace("radius: 0.5", "radius: -1"))
+    result = run("render", "scene.yaml", "bad.yaml", "-o", "none", "--cluster", cluster.scheduler_address)
+    assert (result.exit_code, result.output) == (2, "error: bad.yaml:12:44: objects[2].sphere.radius: must be > 0, "
+                                                    "got -1\n")
+    assert not (tmp_path / "none").exists()

@@ -158,6 +158,45 @@ def test_transformed_shapes_glass_and_every_kind_of_light(yaml_scene, spec, bvh)
     assert len(np.unique(b.reshape(-1, 3), axis=0)) > 1000          # a real picture, not a flat fill
 
 
+GLASS = """
+camera: {eye: [0, 2.5, -8], look_at: [0, 0.8, 0], fov: 40}
+ambient: [0.2, 0.2, 0.2]
+background: [0.3, 0.5, 0.8]
+render: {max_depth: 7, medium_ior: MEDIUM, total_internal_reflection: TIR}
+lights:
+  - {position: [3, 6, -4], color: [0.9, 0.9, 0.9]}
+  - {position: [-4, 5, 1], color: [0.4, 0.4, 0.5], area: {u: [1, 0, 0], v: [0, 0, 1], samples: 2}}
+materials:
+  glass: {diffuse: 0.02, specular: 0.6, shininess: 80, reflection: 1, transmission: 1, ior: 1.5, fresnel: true, shadow: filter}
+  tinted: {diffuse: 0.05, reflection: 0.1, transmission: [0.9, 0.5, 0.4], ior: 1.45, shadow: filter}
+  air: {diffuse: 0, ambient: 0, transmission: 1, ior: 1.0, shadow: false}
+  water: {diffuse: 0.02, ambient: 0, reflection: 0.05, transmission: [0.8, 0.9, 0.95], ior: 1.33, shadow: filter}
+  checks: {texture: {checker: {colors: [[1, 1, 1], [0.2, 0.3, 0.3]], size: 0.5}}}
+objects:
+  - {plane: {point: [0, -0.5, 0]}, material: checks}
+  - {sphere: {center: [-1.6, 1, 0], radius: 1}, material: glass}
+  - {sphere: {center: [-1.6, 1.2, -0.2], radius: 0.4}, material: air}
+  - {box: {min: [0.3, -0.5, -1], max: [2.6, 1.2, 1]}, material: water}
+  - {sphere: {center: [1.4, 0.4, 0], radius: 0.5}, material: tinted}
+  - {cylinder: {base: [0.8, -0.5, -2], top: [0.8, 1.5, -2], radius: 0.3}, material: glass}
+  - {triangle: {vertices: [[-3, -0.5, 2], [-1, -0.5, 2.5], [-2, 2, 2.2]]}, material: tinted}
+  - {sphere: {center: [2.5, 2.2, 2], radius: 0.4}}
+  - {sphere: {center: [-2.8, 2.4, 1], radius: 0.3}, material: glass}
+"""
+
+
+@pytest.mark.parametrize("tir", ["drop", "reflect"])
+@pytest.mark.parametrize("medium, bvh", [("1.0", True), ("1.1", False)])
+def test_glass_media_fresnel_filtered_shadows(yaml_scene, tir, medium, bvh):
+    """Nested media (an air bubble in Fresnel glass, a ball in a water tank, the camera's medium),
+    total internal reflection dropped or reflected, shadows filtered through glass and water."""
+    scene = yaml_scene(GLASS.replace("TIR", tir).replace("MEDIUM", medium))
+    a, b, sa, sb = both(scene, 120, 90, bvh=bvh)
+    assert np.array_equal(a, b), f"{np.count_nonzero((a != b).any(axis=2))} pixels differ"
+    assert (sa.shadow, sa.reflected, sa.refracted) == (sb.shadow, sb.reflected, sb.refracted)
+    assert sb.refracted > 2000 and len(np.unique(b.reshape(-1, 3), axis=0)) > 1500
+
+
 def test_samples_max_depth_block_size_and_workers(yaml_scene):
     scene = yaml_scene(TRANSFORMED.replace("SPEC", "phong"))
     scene.settings.samples, scene.settings.max_depth = 2, 3

@@ -6,6 +6,7 @@ rendered alone, whatever else the command rendered and with how many workers.
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 from pathlib import Path
@@ -122,3 +123,86 @@ def test_skip_existing_with_every_frame_written_renders_nothing_and_reaches_no_c
     assert {p: os.stat(tmp_path / p).st_mtime_ns for p in ("f1.png", "f2.png")} == before
     with Image.open(tmp_path / "m.gif") as movie:
         assert movie.n_frames == 2
+
+
+# --- frames beside the other ways to render: several scenes, views, explain, statistics ---
+@pytest.mark.parametrize("args", [
+    ["--frames", "1-2"],
+    ["--movie", "m.gif"],
+    ["-o", "all.gif"],
+])
+def test_frame_sequences_of_several_scenes_are_a_usage_error(run, tmp_path, args):
+    shutil.copy(ORBIT, tmp_path / "other.yaml")
+    result = run("render", "orbit.yaml", "other.yaml", *args, *SMALL)
+    assert (result.exit_code, result.output) == (2, "error: --frames and movies render one animated scene, not "
+                                                    "several (--frame N renders frame N of each)\n")
+    assert sorted(os.listdir(tmp_path)) == ["orbit.yaml", "other.yaml"]
+
+
+def test_frame_n_of_several_scenes_is_each_scene_s_frame_n(run, tmp_path):
+    shutil.copy(ORBIT, tmp_path / "other.yaml")
+    result = run("render", "orbit.yaml", "other.yaml", "--frame", "6", "-o", "out", "--stats", "--json", *SMALL)
+    assert result.exit_code == 0, result.output
+    assert [json.loads(line)["output"] for line in result.output.splitlines()] == ["out/orbit.png", "out/other.png"]
+    assert run("render", "orbit.yaml", "--frame", "6", "-o", "six.png", *SMALL).exit_code == 0
+    for name in ("orbit", "other"):
+        assert (tmp_path / "out" / f"{name}.png").read_bytes() == (tmp_path / "six.png").read_bytes()
+    (tmp_path / "still.yaml").write_text("camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n")
+    result = run("render", "orbit.yaml", "still.yaml", "--frame", "2", "-o", "out2", *SMALL)
+    assert (result.exit_code, result.output) == (2, "error: --frame 2: still.yaml is a still (one frame)\n")
+    assert not (tmp_path / "out2").exists()
+
+
+def test_skip_existing_with_several_scenes_renders_only_the_missing_images(run, tmp_path):
+    shutil.copy(ORBIT, tmp_path / "other.yaml")
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "orbit.png").write_bytes(b"kept")
+    result = run("render", "orbit.yaml", "other.yaml", "-o", "out", "--skip-existing", "--stats", *SMALL)
+    assert result.exit_code == 0, result.output
+    assert result.output.startswith("other.yaml: rays: ") and result.output.count("\n") == 1
+    assert (tmp_path / "out" / "orbit.png").read_bytes() == b"kept"
+    assert Image.open(tmp_path / "out" / "other.png").size == (40, 30)
+
+
+def test_a_view_and_an_explanation_take_the_frame(run, tmp_path):
+    import rtcli
+    for k in (1, 5):
+        assert run("render", "orbit.yaml", "--frame", str(k), "-o", f"f{k}.png", *SMALL).exit_code == 0
+        assert run("render", "orbit.yaml", "--frame", str(k), "--view", "depth", "-o", f"d{k}.png",
+                   *SMALL).exit_code == 0
+    f1, f5 = (np.asarray(Image.open(tmp_path / f"f{k}.png")) for k in (1, 5))
+    view = rtcli.view(rtcli.load_scene("orbit.yaml", frame=5), "depth", width=40)
+    assert np.array_equal(np.asarray(Image.open(tmp_path / "d5.png")), view.to_8bit())
+    assert (tmp_path / "d1.png").read_bytes() != (tmp_path / "d5.png").read_bytes()
+    y, x = np.argwhere(np.any(f1 != f5, axis=2))[0]
+    result = run("explain", "orbit.yaml", str(x), str(y), "--frame", "5", "--json", *SMALL)
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.output)["byte"] == f5[y, x].tolist()
+    result = run("explain", "orbit.yaml", "1", "1", "--frame", "25")
+    assert (result.exit_code, result.output) == (2, "error: --frame 25: orbit.yaml has 24 frames (1-24)\n")
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--view", "normal", "--frames", "1-2"], "--view writes one picture: give --frame N, not --frames, a frame "
+                                              "pattern or a movie"),
+    (["--view", "normal", "-o", "n%d.png"], "--view writes one picture: give --frame N, not --frames, a frame "
+                                            "pattern or a movie"),
+    (["--view", "normal", "--local-cluster", "2"], "--view is computed on this machine: it takes no cluster option"),
+])
+def test_views_of_several_frames_or_on_a_cluster_are_usage_errors(run, tmp_path, args, message):
+    result = run("render", "orbit.yaml", *args, *SMALL)
+    assert (result.exit_code, result.output) == (2, f"error: {message}\n")
+    assert os.listdir(tmp_path) == ["orbit.yaml"]
+
+
+def test_stats_of_a_sequence_count_the_frames_rendered(run, tmp_path):
+    result = run("render", "orbit.yaml", "--frames", "2-4", "-o", "f%d.png", "--stats", "--json", *SMALL)
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    assert (data["scene"], data["frames"], data["primary"], data["width"]) == ("orbit.yaml", [2, 3, 4], 3 * 1200, 40)
+    os.unlink(tmp_path / "f3.png")
+    result = run("render", "orbit.yaml", "--frames", "2-4", "-o", "f%d.png", "--stats", "--json", "--skip-existing",
+                 *SMALL)
+    assert (json.loads(result.output)["frames"], json.loads(result.output)["primary"]) == ([3], 1200)
+    result = run("render", "orbit.yaml", "--frames", "2-4", "-o", "f%d.png", "--stats", *SMALL)
+    assert result.output.startswith("rays: 3600 primary, ") and result.output.count("\n") == 1

@@ -129,7 +129,7 @@ def hits_scalar(shape, variant, o, d, t_min, t_max):
         from rtcli.shapes.triangle import triangle_leaf
         geo, stack = mesh_geometry(shape), np.zeros(shape.bvh.depth + 2, np.int64)
         f = scalar(walk, variant, LEAF=triangle_leaf)
-        out = [f(geo, 0, *o[:, i], *d[:, i], t_min[i], t_max[i], False, stack, 0) for i in range(n)]
+        out = [f(geo, 0, *o[:, i], *d[:, i], t_min[i], t_max[i], 0, stack, 0) for i in range(n)]
         return np.array([r[0] for r in out], float), np.array([r[1] for r in out])
     f = scalar(shape.kernels.hit, variant)
     out = [f(shape.row, shape.pool, *o[:, i], *d[:, i], t_min[i], t_max[i]) for i in range(n)]
@@ -283,9 +283,10 @@ def test_transformed_hits_and_normals_agree(name, shape, variant, mirror):
 # --- the core's kernels ---
 def core_cases():
     """(name, kernel, numpy arguments, per-ray arguments (i) -> tuple, count)."""
-    from rtcli.core import camera, jitter, lights, shading, textures, vec
+    from rtcli.core import camera, dielectric, jitter, lights, shading, textures, vec
     rng = np.random.default_rng(9)
     n = 400
+    stacks, counts = rng.choice([1.0, 1.33, 1.5, 2.4], (4, n)), rng.integers(0, 5, n)
     a, b = rng.normal(size=(3, n)), rng.normal(size=(3, n))
     unit_b = b / np.linalg.norm(b, axis=0)
     eta = rng.choice([1 / 1.5, 1.5, 1.33], n)
@@ -318,6 +319,8 @@ def core_cases():
         ("specular_cos blinn", shading.specular_cos, (True, *unit_b, *(a / np.linalg.norm(a, axis=0)),
                                                       *(-unit_b), a[0], b[0])),
         ("facing", shading.facing, (*a, *unit_b, *(unit_b + 0.3 * a))),
+        ("fresnel", dielectric.fresnel, (rng.uniform(0, 1, n), eta)),
+        ("indices", dielectric.indices, (stacks, counts, 1.1, rng.choice([1.0, 1.33, 1.5, 2.4], n), cells % 2 == 0)),
     ]
     return cases, n
 
@@ -335,13 +338,33 @@ def test_core_kernels_agree(name, kernel, args, variant):
     count = N_CORE if variant == "compiled" else PYTHON_RAYS
 
     def at(x, i):
-        return x[i] if isinstance(x, np.ndarray) and x.shape == (N_CORE,) else x
+        if isinstance(x, np.ndarray) and x.shape[-1:] == (N_CORE,):
+            return x[i] if x.ndim == 1 else x[:, i]            # a ray's value, or its column of a stack
+        return x
     ones = [f(*(at(x, i) for x in args)) for i in range(count)]
     ones = [r if isinstance(r, tuple) else (r,) for r in ones]
     bound = 4 if variants.inexact(kernel) else 0
     for k, part in enumerate(whole):
         assert_agree(np.broadcast_to(part, (N_CORE,))[:count].astype(float), [float(r[k]) for r in ones], bound,
                      f"{name}[{k}]")
+
+
+@pytest.mark.parametrize("variant", SCALAR)
+def test_media_stacks_agree(variant):
+    """refracted_media fills the refracted rays' stacks: (D, n) columns at once, or one (D,) row."""
+    from rtcli.core.dielectric import refracted_media
+    rng = np.random.default_rng(6)
+    n = 300
+    ior, count = rng.choice([1.0, 1.33, 1.5], (5, n)), rng.integers(0, 5, n)
+    ior_m, entering = rng.choice([1.0, 1.33, 1.5], n), rng.random(n) < 0.5
+    count = np.where(entering, np.minimum(count, 4), count)
+    whole = np.zeros((5, n))
+    counts = refracted_media(ior, count, ior_m, entering, whole)
+    f = scalar(refracted_media, variant)
+    for i in range(n if variant == "compiled" else PYTHON_RAYS):
+        row = np.zeros(5)
+        assert f(ior[:, i].copy(), int(count[i]), ior_m[i], bool(entering[i]), row) == counts[i]
+        np.testing.assert_array_equal(row[:counts[i]], whole[:counts[i], i])
 
 
 def test_shading_kernels_agree_on_material_tables(yaml_scene):

@@ -9,10 +9,11 @@ integrator written for one ray, so no array is built per bounce:
 Every formula comes from the shared kernels: the camera ray (core/camera.py), the
 shapes' normals and (u, v) (rtcli/shapes/), textures, lights and the local term
 (core/textures.py, core/lights.py, core/shading.py), reflect and refract
-(core/vec.py). What is this engine's own is the order of work: a loop over depth
-with a stack of frames in place of recursion (numba's recursion is slow and breaks
-its on-disk cache). frames[L] holds the hit at depth L + 1 while its secondary rays
-are traced; its columns have the names below.
+(core/vec.py), media, Fresnel and the rays' weights (core/dielectric.py). What is
+this engine's own is the order of work: a loop over depth with a stack of frames in
+place of recursion (numba's recursion is slow and breaks its on-disk cache).
+frames[L] holds the hit at depth L + 1 while its secondary rays are traced, and the
+media of the ray that made it; its columns have the names below.
 """
 
 from __future__ import annotations
@@ -21,7 +22,9 @@ import numpy as np
 
 from rtcli.compiled.pack import KIND, MATERIAL, XFORM
 from rtcli.compiled.query import NORMALS_ANY, UV_ANY, scene_hit
+from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.camera import primary_ray
+from rtcli.core.dielectric import FEELER_CROSSINGS, fresnel, indices, refracted_media, split
 from rtcli.core.lights import COLOR, sample_point, toward, weight
 from rtcli.core.shading import ambient, diffuse, facing, specular, specular_cos
 from rtcli.core.textures import IMAGE, NONE, texture_color
@@ -31,10 +34,12 @@ from rtcli.core.vec import dot, reflect, refract, unit
 from rtcli.variants import per_ray
 
 # A frame: the local color so far, the hit point p, the facing shading normal n and geometric
-# normal ng, the unit direction D of the ray that hit, entering (1 or 0), the material, and
-# which secondary ray comes next (STAGE: 0 the mirror ray, 1 the refracted ray, 2 done).
+# normal ng, the unit direction D of the ray that hit, entering (1 or 0), the material, which
+# secondary ray comes next (STAGE: 0 the mirror ray, 1 the refracted ray, 2 done), the weights
+# of the mirror and refracted rays, the refracted direction, and the media the ray is in: how
+# many, then their iors (max_depth slots from MEDIA_IOR on).
 COLOR_SUM, P, N, NG, D, ENTERING, MATERIAL_OF, STAGE = 0, 3, 6, 9, 12, 15, 16, 17
-FRAME = 18
+W_REFLECT, W_REFRACT, REFRACTED_DIR, MEDIA_COUNT, MEDIA_IOR = 18, 21, 24, 27, 28
 SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
 
 
@@ -68,6 +73,27 @@ def texture_at(g, s, m, k, prim, px, py, pz):
 
 
 @per_ray(inline=True)
+def transmittance(g, s, sx, sy, sz, dx, dy, dz, stack):
+    """(r, g, b): how much of a light reaches along the feeler s + t d, 0 < t < 1 (as
+    wavefront.intersect.transmittance): 0 behind a full shadow caster, times kt at each surface of
+    a `shadow: filter` object, 0 past FEELER_CROSSINGS crossings."""
+    if not s.any_filter:
+        if scene_hit(g, sx, sy, sz, dx, dy, dz, 0.0, 1.0, ANY_CASTER, stack)[1] >= 0:
+            return 0.0, 0.0, 0.0
+        return 1.0, 1.0, 1.0
+    Tr, Tg, Tb, t0 = 1.0, 1.0, 1.0, 0.0
+    for _ in range(FEELER_CROSSINGS):
+        t, k, _ = scene_hit(g, sx, sy, sz, dx, dy, dz, t0, 1.0, NEAREST_CASTER, stack)
+        if k < 0:
+            return Tr, Tg, Tb
+        m = g.ints[k, MATERIAL]
+        if not s.filters[m]:
+            return 0.0, 0.0, 0.0
+        Tr, Tg, Tb, t0 = Tr * s.kt[m, 0], Tg * s.kt[m, 1], Tb * s.kt[m, 2], t
+    return 0.0, 0.0, 0.0
+
+
+@per_ray(inline=True)
 def local(g, s, m, Tr, Tg, Tb, px, py, pz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, counts, stack):
     """The local term for one hit: emission and ambient, then each light point that sees it:
     N.L > 0 and a shadow feeler from the point stepped off the surface reaching it."""
@@ -76,7 +102,6 @@ def local(g, s, m, Tr, Tg, Tb, px, py, pz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, c
     sx, sy, sz = px + s.offset * gx, py + s.offset * gy, pz + s.offset * gz    # the lit side
     for li in range(len(s.lights)):
         light, samples = s.lights[li], s.samples[li]
-        I = light[COLOR:COLOR + 3]
         for cell in range(samples):
             qx, qy, qz = sample_point(light, cell, px, py, pz)
             Lx, Ly, Lz, r = toward(qx, qy, qz, px, py, pz)
@@ -84,8 +109,10 @@ def local(g, s, m, Tr, Tg, Tb, px, py, pz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, c
             if not NL > 0:                                              # no contribution (004, case 2)
                 continue
             counts[SHADOW] += 1
-            if scene_hit(g, sx, sy, sz, qx - sx, qy - sy, qz - sz, 0.0, 1.0, True, stack)[1] >= 0:
+            through = transmittance(g, s, sx, sy, sz, qx - sx, qy - sy, qz - sz, stack)
+            if not (through[0] > 0 or through[1] > 0 or through[2] > 0):
                 continue
+            I = (light[COLOR] * through[0], light[COLOR + 1] * through[1], light[COLOR + 2] * through[2])
             w = weight(light, r, Lx, Ly, Lz, samples)
             dr, dg, db = diffuse(s, m, I, w, NL, Tr, Tg, Tb)
             cr, cg, cb = cr + dr, cg + dg, cb + db
@@ -98,9 +125,10 @@ def local(g, s, m, Tr, Tg, Tb, px, py, pz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, c
 
 @per_ray(inline=True)
 def shade_local(g, s, ray, f, counts, stack):
-    """First hit and local term of one ray: (hit?, color); on a hit, f is its frame."""
+    """First hit and local term of one ray: (hit?, color); on a hit, f is its frame (whose media
+    the caller has set), with the weights of the secondary rays."""
     ox, oy, oz, dx, dy, dz = ray
-    t, k, prim = scene_hit(g, ox, oy, oz, dx, dy, dz, 0.0, np.inf, False, stack)
+    t, k, prim = scene_hit(g, ox, oy, oz, dx, dy, dz, 0.0, np.inf, NEAREST, stack)
     if k < 0:
         return False, s.background[0], s.background[1], s.background[2]
     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
@@ -114,30 +142,46 @@ def shade_local(g, s, ray, f, counts, stack):
     f[P], f[P + 1], f[P + 2], f[N], f[N + 1], f[N + 2] = px, py, pz, nx, ny, nz
     f[NG], f[NG + 1], f[NG + 2], f[D], f[D + 1], f[D + 2] = gx, gy, gz, Dx, Dy, Dz
     f[ENTERING], f[MATERIAL_OF], f[STAGE] = 1.0 if entering else 0.0, m, 0
+    f[W_REFLECT], f[W_REFLECT + 1], f[W_REFLECT + 2] = s.kr[m, 0], s.kr[m, 1], s.kr[m, 2]
+    f[W_REFRACT], f[W_REFRACT + 1], f[W_REFRACT + 2] = 0.0, 0.0, 0.0
+    if s.clear[m] or s.fresnel[m]:
+        n1, n2 = indices(f[MEDIA_IOR:MEDIA_IOR + s.max_depth], int(f[MEDIA_COUNT]), s.medium_ior, s.ior[m],
+                         entering)
+        eta = n1 / n2
+        tx, ty, tz, tir = refract(Dx, Dy, Dz, nx, ny, nz, eta)
+        R = fresnel(-dot(Dx, Dy, Dz, nx, ny, nz), eta) if s.fresnel[m] else 0.0      # split needs it only then
+        wr, wt = split(s, m, R, tir, s.reflect_tir)
+        f[W_REFLECT], f[W_REFLECT + 1], f[W_REFLECT + 2] = wr
+        f[W_REFRACT], f[W_REFRACT + 1], f[W_REFRACT + 2] = wt
+        f[REFRACTED_DIR], f[REFRACTED_DIR + 1], f[REFRACTED_DIR + 2] = tx, ty, tz
     return True, cr, cg, cb
 
 
 @per_ray(inline=True)
-def next_ray(s, f, counts):
-    """The frame's next secondary ray (trace.shade): the mirror ray at stage 0, the refracted
-    ray at stage 1 (none past the critical angle); (False, _) when none is left. Each starts
-    s.offset off the surface, on the side it leaves to."""
-    m = int(f[MATERIAL_OF])
+def next_ray(s, f, child, counts):
+    """The frame's next secondary ray (trace.shade): the mirror ray at stage 0 (if its weight is
+    not 0), the refracted ray at stage 1 (none past the critical angle: its weight is 0);
+    (False, _) when none is left. Each starts s.offset off the surface, on the side it leaves to;
+    its media go into the child frame (the mirror ray stays in the ray's media)."""
+    depth = s.max_depth
     ex, ey, ez = s.offset * f[NG], s.offset * f[NG + 1], s.offset * f[NG + 2]
     if f[STAGE] == 0:
         f[STAGE] = 1
-        if s.mirror[m]:
+        if f[W_REFLECT] > 0 or f[W_REFLECT + 1] > 0 or f[W_REFLECT + 2] > 0:
             counts[REFLECTED] += 1
+            for j in range(MEDIA_COUNT, MEDIA_IOR + depth):
+                child[j] = f[j]
             rx, ry, rz = reflect(f[D], f[D + 1], f[D + 2], f[N], f[N + 1], f[N + 2])
             return True, (f[P] + ex, f[P + 1] + ey, f[P + 2] + ez, rx, ry, rz)
     if f[STAGE] == 1:
         f[STAGE] = 2
-        if s.clear[m]:
-            eta = 1.0 / s.ior[m] if f[ENTERING] else s.ior[m]           # 1 -> ior entering, ior -> 1 leaving
-            tx, ty, tz, tir = refract(f[D], f[D + 1], f[D + 2], f[N], f[N + 1], f[N + 2], eta)
-            if not tir:
-                counts[REFRACTED] += 1
-                return True, (f[P] - ex, f[P + 1] - ey, f[P + 2] - ez, tx, ty, tz)
+        if f[W_REFRACT] > 0 or f[W_REFRACT + 1] > 0 or f[W_REFRACT + 2] > 0:
+            counts[REFRACTED] += 1
+            m = int(f[MATERIAL_OF])
+            child[MEDIA_COUNT] = refracted_media(f[MEDIA_IOR:MEDIA_IOR + depth], int(f[MEDIA_COUNT]), s.ior[m],
+                                                 f[ENTERING] != 0, child[MEDIA_IOR:MEDIA_IOR + depth])
+            return True, (f[P] - ex, f[P + 1] - ey, f[P + 2] - ez, f[REFRACTED_DIR], f[REFRACTED_DIR + 1],
+                          f[REFRACTED_DIR + 2])
     return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
@@ -146,19 +190,19 @@ def radiance(g, s, ray, counts, frames, stack):
     """The color seen along one primary ray: local + kr radiance(mirror) + kt radiance(refracted),
     depth first with frames[L] the pending hit at depth L + 1 instead of recursion."""
     L = 0
+    frames[0, MEDIA_COUNT] = 0                                        # the camera is in the scene's medium
     while True:
         found, cr, cg, cb = shade_local(g, s, ray, frames[L], counts, stack)
         more = False
         if found and L + 1 < s.max_depth:
-            more, ray = next_ray(s, frames[L], counts)
+            more, ray = next_ray(s, frames[L], frames[L + 1], counts)
         while not more and L > 0:                                     # hand the color to the parent
             L -= 1
             f = frames[L]
-            m = int(f[MATERIAL_OF])
-            k = s.kr[m] if f[STAGE] == 1 else s.kt[m]
-            f[COLOR_SUM], f[COLOR_SUM + 1], f[COLOR_SUM + 2] = (f[COLOR_SUM] + k[0] * cr, f[COLOR_SUM + 1] + k[1] * cg,
-                                                                f[COLOR_SUM + 2] + k[2] * cb)
-            more, ray = next_ray(s, f, counts)
+            w = W_REFLECT if f[STAGE] == 1 else W_REFRACT
+            f[COLOR_SUM], f[COLOR_SUM + 1], f[COLOR_SUM + 2] = (f[COLOR_SUM] + f[w] * cr, f[COLOR_SUM + 1] + f[w + 1] * cg,
+                                                                f[COLOR_SUM + 2] + f[w + 2] * cb)
+            more, ray = next_ray(s, f, frames[L + 1], counts)
             cr, cg, cb = f[COLOR_SUM], f[COLOR_SUM + 1], f[COLOR_SUM + 2]
         if not more:
             return cr, cg, cb
@@ -171,7 +215,7 @@ def trace_camera(g, s, cam, x, y, nc, nr, counts, stack):
     (its row: rtcli/core/camera.py)."""
     n = len(x)
     out = np.empty((n, 3))
-    frames = np.empty((max(s.max_depth, 1), FRAME))
+    frames = np.empty((max(s.max_depth, 1), MEDIA_IOR + s.max_depth))
     for i in range(n):
         out[i] = radiance(g, s, primary_ray(cam, x[i], y[i], nc, nr), counts, frames, stack)
     return out

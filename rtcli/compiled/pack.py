@@ -42,8 +42,9 @@ KINDS = {cls: k for k, cls in enumerate(SHAPES.values())}
 
 # Few arrays on purpose: numba passes each array argument as several machine words.
 Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool")
-Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear texture texels "
-                            "lights samples ambient background offset max_depth blinn")
+Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear fresnel filters texture "
+                            "texels lights samples ambient background offset max_depth blinn medium_ior "
+                            "reflect_tir any_filter")
 
 
 def unsupported(scene) -> str | None:
@@ -126,6 +127,8 @@ def looks(scene) -> Looks:
     samples = np.array([light.samples for light in scene.lights], dtype=np.int64)
     return Looks(table.ka, table.kd, table.ks, table.shininess, table.emission, table.kr, table.kt, table.ior,
                  table.shiny.astype(np.int64), table.mirror.astype(np.int64), table.clear.astype(np.int64),
-                 table.texture, table.texels, scene.light_rows, samples, np.asarray(scene.ambient, float),
-                 np.asarray(scene.background, float), float(scene.offset), int(scene.settings.max_depth),
-                 scene.settings.specular == "blinn")
+                 table.fresnel, table.filters.astype(np.int64), table.texture, table.texels, scene.light_rows,
+                 samples, np.asarray(scene.ambient, float), np.asarray(scene.background, float),
+                 float(scene.offset), int(scene.settings.max_depth), scene.settings.specular == "blinn",
+                 float(scene.settings.medium_ior), scene.settings.total_internal_reflection == "reflect",
+                 bool(table.filters.any()))

@@ -17,7 +17,7 @@ when numba is installed.
 from __future__ import annotations
 
 from rtcli.compiled.pack import CASTS, KIND, XFORM
-from rtcli.core.bvh import CHILD, COUNT, walk, walk_rays
+from rtcli.core.bvh import ANY_CASTER, CHILD, COUNT, NEAREST, walk, walk_rays
 from rtcli.core.transform import ray_to_object
 from rtcli.shapes import SHAPES
 from rtcli.shapes.triangle import triangle_leaf
@@ -99,7 +99,7 @@ def object_hit(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom
 @per_ray(inline=True)
 def object_leaf(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
     """A leaf entry of the scene's tree: object k (skipped by a feeler if it casts no shadow)."""
-    if shadow and g.ints[k, CASTS] == 0:
+    if shadow != NEAREST and g.ints[k, CASTS] == 0:
         return INF, 0
     return object_hit(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)
 
@@ -109,17 +109,18 @@ WALK_OBJECTS = compiled(walk, LEAF=object_leaf)
 
 @per_ray(inline=True)
 def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
-    """(t, object, prim): the nearest hit in (t_min, t_max), or with `shadow` any hit by a
-    shadow-casting object; object -1 on a miss. stack: scratch for both tree levels."""
+    """(t, object, prim): the nearest hit in (t_min, t_max); with `shadow` (a mode of
+    core/bvh.py) among the objects that cast shadows, any (ANY_CASTER) or the nearest; object -1
+    on a miss. stack: scratch for both tree levels."""
     best, obj, prim = t_max, -1, 0
     for j in range(len(g.listed)):
         k = g.listed[j]
-        if shadow and g.ints[k, CASTS] == 0:
+        if shadow != NEAREST and g.ints[k, CASTS] == 0:
             continue
         t, p = object_hit(g, k, ox, oy, oz, dx, dy, dz, t_min, best, shadow, stack, 0)
         if t < best:
             best, obj, prim = t, k, p
-            if shadow:
+            if shadow == ANY_CASTER:
                 return best, obj, prim
     if g.links[0, CHILD] < 0 and g.links[0, COUNT] == 0:          # no tree (a scene of few objects)
         return best, obj, prim

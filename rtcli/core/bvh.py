@@ -35,6 +35,9 @@ CHUNK = 1 << 13                         # rays traversed together by the numpy w
 PAD = 1e-9                              # boxes grow by PAD x their largest |coordinate|, so rounding in
                                         # the slab test cannot drop a hit lying on a box face
 CHILD, START, COUNT = 0, 1, 2           # columns of links
+NEAREST, ANY_CASTER, NEAREST_CASTER = 0, 1, 2     # what a per-ray walk looks for (its `shadow` mode):
+                                        # the nearest hit; any object that casts shadows (a feeler
+                                        # stops at the first); the nearest such object
 
 
 class BVH:
@@ -172,8 +175,9 @@ def entry(nodes, node, ox, oy, oz, ix, iy, iz, t_near, t_far):
 @per_ray
 def walk(g, root, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
     """(t, entry, prim): the nearest hit in (t_min, t_max) among the leaf entries of the tree
-    at `root` in g.nodes / g.links / g.perm, by LEAF; entry -1 on a miss. With `shadow`, the
-    first hit found will do. stack[bottom:] is scratch (a LEAF may walk a tree of its own above)."""
+    at `root` in g.nodes / g.links / g.perm, by LEAF; entry -1 on a miss. `shadow` is the mode
+    (NEAREST, ANY_CASTER: the first hit found will do, NEAREST_CASTER), passed on to LEAF.
+    stack[bottom:] is scratch (a LEAF may walk a tree of its own above)."""
     ix, iy, iz = reciprocal(dx), reciprocal(dy), reciprocal(dz)
     best, won, prim = t_max, -1, 0
     stack[bottom], top = root, bottom + 1
@@ -201,7 +205,7 @@ def walk(g, root, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
             t, p = LEAF(g, g.perm[j], ox, oy, oz, dx, dy, dz, t_min, best, shadow, stack, top)  # noqa: F821
             if t < best:
                 best, won, prim = t, g.perm[j], p
-                if shadow:
+                if shadow == ANY_CASTER:
                     return best, won, prim
     return (best if won >= 0 else INF), won, prim
 

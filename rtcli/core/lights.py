@@ -72,13 +72,23 @@ def toward(qx, qy, qz, px, py, pz):
 
 
 @kernel
-def weight(light, r, Lx, Ly, Lz, samples):
-    """The share of I reaching the point: att(r) = 1 / (c0 + c1 r + c2 r^2) (notes 004), times
-    the spot factor (cos of the angle to the axis)^falloff inside the cone and 0 outside, over
-    the number of the light's sample points."""
-    att = 1.0 / (light[ATTENUATION] + light[ATTENUATION + 1] * r + light[ATTENUATION + 2] * r * r)
+def attenuation(light, r):
+    """att(r) = 1 / (c0 + c1 r + c2 r^2) (notes 004)."""
+    return 1.0 / (light[ATTENUATION] + light[ATTENUATION + 1] * r + light[ATTENUATION + 2] * r * r)
+
+
+@kernel
+def spot_factor(light, Lx, Ly, Lz):
+    """1 for a point light; for a spot, (cos of the angle between its axis and -L)^falloff inside the
+    cone and 0 outside."""
     if light[IS_SPOT] == 0:
-        return att * 1.0 / samples
+        return 1.0
     cos = -dot(Lx, Ly, Lz, light[SPOT_AXIS], light[SPOT_AXIS + 1], light[SPOT_AXIS + 2])
-    spot = select(cos >= light[SPOT_COS], maximum(cos, 0.0) ** light[SPOT_FALLOFF], 0.0)
-    return att * spot / samples
+    return select(cos >= light[SPOT_COS], maximum(cos, 0.0) ** light[SPOT_FALLOFF], 0.0)
+
+
+@kernel
+def weight(light, r, Lx, Ly, Lz, samples):
+    """The share of I reaching the point: att(r) times the spot factor, over the number of the
+    light's sample points."""
+    return attenuation(light, r) * spot_factor(light, Lx, Ly, Lz) / samples

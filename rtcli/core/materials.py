@@ -28,8 +28,10 @@ class Material:
     reflection: np.ndarray = field(default_factory=lambda: _rgb(0.0))   # kr, weight of the mirror ray
     transmission: np.ndarray = field(default_factory=lambda: _rgb(0.0)) # kt, weight of the refracted ray
     ior: float = 1.0                                                    # index of refraction inside
-    shadow: bool = True                                                 # casts a shadow
+    shadow: bool | str = True                                           # True full, False none, "filter"
+    fresnel: bool = False                                               # kr, kt scale Fresnel's R, 1 - R
     texture: object = None                                              # Checker, ImageTexture or None
+    name: str = ""                                                      # its name in `materials:`, if any
 
 
 class MaterialTable:
@@ -41,7 +43,9 @@ class MaterialTable:
         self.ka, self.kd, self.ks = stack("ambient"), stack("diffuse"), stack("specular")
         self.shininess, self.emission = stack("shininess"), stack("emission")
         self.kr, self.kt, self.ior = stack("reflection"), stack("transmission"), stack("ior")
-        self.shadow = np.array([m.shadow for m in materials], dtype=bool)
+        self.shadow = np.array([m.shadow is not False for m in materials], dtype=bool)   # stops or filters
+        self.filters = np.array([m.shadow == "filter" for m in materials], dtype=bool)   # lets light through
+        self.fresnel = np.array([m.fresnel for m in materials], dtype=np.int64)
         self.shiny = self.ks.max(axis=1) > 0            # which materials need the specular term,
         self.mirror = self.kr.max(axis=1) > 0           # a mirror ray,
         self.clear = self.kt.max(axis=1) > 0            # a refracted ray

@@ -69,6 +69,8 @@ class Settings:
     specular: str = "phong"          # phong: (R.V)^n, blinn: (N.H)^n
     samples: int = 1                 # n x n per pixel
     epsilon: float = 1e-6            # self-intersection offset, relative to the scene's size
+    medium_ior: float = 1.0          # index of refraction around every object (the camera's medium)
+    total_internal_reflection: str = "drop"   # drop: the refracted weight is lost; reflect: to the mirror ray
 
 
 @dataclass

@@ -6,6 +6,7 @@ Params, so unknown keys are reported with file:line:col.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import gc
 
@@ -81,7 +82,7 @@ def build_scene(docs: list) -> Scene:
     for p in params:
         for name, mp in _materials(p):
             named[name] = len(table)
-            table.append(material_from(mp))
+            table.append(dataclasses.replace(material_from(mp), name=name))
     builder, lights = ObjectBuilder(named, table, 0), []
     for p in params:
         lights += [light_from(as_params(item, where, path, "a light mapping"))
@@ -117,6 +118,8 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
         settings.specular = r.choice("specular", ("phong", "blinn"), "phong")
         settings.samples = r.integer("samples", 1, 1, 16)
         settings.epsilon = r.number("epsilon", 1e-6, positive=True)
+        settings.medium_ior = r.number("medium_ior", 1.0, positive=True)
+        settings.total_internal_reflection = r.choice("total_internal_reflection", ("drop", "reflect"), "drop")
         r.check_unused()
     camera, eye = camera_from(p.sub("camera"))
     check_resolvable(p, camera, settings.width, settings.height)

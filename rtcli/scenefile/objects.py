@@ -56,11 +56,20 @@ def material_from(p: Params) -> Material:
         reflection=p.coefficient("reflection", 0.0, at_most=1),      # at most 1: no light grows along a path
         transmission=p.coefficient("transmission", 0.0, at_most=1),
         ior=p.number("ior", 1.0, positive=True),
-        shadow=p.boolean("shadow", True),
+        shadow=_shadow(p),
+        fresnel=p.boolean("fresnel", False),
         texture=None if texture is None else reused(texture.node, None, lambda: texture_from(texture)),
     )
     p.check_unused()
     return m
+
+
+def _shadow(p: Params):
+    """`shadow:` true (the default: a full shadow), false (none) or filter (light passes, times kt)."""
+    value = p.raw("shadow", True)
+    if value not in (True, False, "filter"):
+        raise p.error("shadow", f"must be true, false or filter, got {describe(value)}")
+    return value
 
 
 def texture_from(p: Params):

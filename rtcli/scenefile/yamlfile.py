@@ -28,7 +28,7 @@ from rtcli.scenefile.limits import MAX_INCLUDE_DEPTH, MAX_SCENE_BYTES
 from rtcli.scenefile.nodes import MapNode, SeqNode
 from rtcli.scenefile.yamlevents import Builder, Loader
 
-__all__ = ["MapNode", "SeqNode", "INCLUDABLE", "parse", "read_text", "load"]
+__all__ = ["MapNode", "SeqNode", "INCLUDABLE", "parse", "read_text", "load", "load_tree"]
 
 INCLUDABLE = {"version", "include", "materials", "lights", "objects"}
 
@@ -103,6 +103,17 @@ def load(path: str) -> list[MapNode]:
     """The scene file and its includes, included documents first (depth first), each file once."""
     docs: list[MapNode] = []
     _load(path, None, "", (), docs, set())
+    return docs
+
+
+def load_tree(tree: MapNode) -> list[MapNode]:
+    """A scene given as a tree (parsed YAML text, or a dict from the Python API) and its includes,
+    as load() gives a file's: included documents first, the tree last."""
+    docs: list[MapNode] = []
+    seen: set = set()
+    for k, name, item_where in _includes(tree):
+        _load(os.path.normpath(os.path.join(tree.folder, name)), item_where, f"include[{k}]", (), docs, seen)
+    docs.append(tree)
     return docs
 
 

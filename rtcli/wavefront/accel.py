@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli import variants
+from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.scene import object_tree
 from rtcli.core.vec import unit
 from rtcli.shapes.sphere import Sphere
@@ -55,17 +56,22 @@ class Accelerator:
             t, _ = Sphere.kernels.hit(self.spheres[:, k], None, *o[:, r], *d[:, r], t_min, t_max)
         return t
 
-    def _pair_test(self, scene, o, d, t_min, r, m, t_max):
-        """(t, prim) of (ray r, member m) pairs in (t_min, t_max)."""
+    def _pair_test(self, scene, o, d, t_min, r, m, t_max, casters: bool = False):
+        """(t, prim) of (ray r, member m) pairs in (t_min, t_max) (with `casters`: members that
+        cast shadows only)."""
         obj = self.members[m]
         t, prim = np.full(len(r), np.inf), np.zeros(len(r), dtype=np.int64)
-        sph = self.is_sphere[obj]
+        low = np.asarray(t_min, dtype=float)
+        low = low if low.ndim == 0 else low[r]
+        live = self.shadow[obj] if casters else np.ones(len(r), dtype=bool)
+        sph = self.is_sphere[obj] & live
         if sph.any():
-            t[sph] = self._sphere_t(o, d, r[sph], obj[sph], t_min, t_max[sph])
-        rest = np.flatnonzero(~sph)
+            t[sph] = self._sphere_t(o, d, r[sph], obj[sph], low if low.ndim == 0 else low[sph], t_max[sph])
+        rest = np.flatnonzero(~self.is_sphere[obj] & live)
         for k in np.unique(obj[rest]):
             rows = rest[obj[rest] == k]
-            t[rows], prim[rows] = object_hit(scene.objects[k], o[:, r[rows]], d[:, r[rows]], t_min, t_max[rows])
+            t[rows], prim[rows] = object_hit(scene.objects[k], o[:, r[rows]], d[:, r[rows]],
+                                             low if low.ndim == 0 else low[rows], t_max[rows])
         return t, prim
 
     def _pair_blocks(self, scene, o, d, r, m):
@@ -81,8 +87,8 @@ class Accelerator:
             blocked[rows] = blocks(scene.objects[k], o[:, r[rows]], d[:, r[rows]], 0.0, 1.0)
         return select(blocked, 0.5, INF)
 
-    def _walk(self, scene, o, d, t_min, t_max, shadow: bool):
-        """The compiled walk over the scene's tree: (t, object, prim) per ray."""
+    def _walk(self, scene, o, d, t_min, t_max, mode: int):
+        """The compiled walk over the scene's tree: (t, object, prim) per ray (mode: core/bvh.py)."""
         from rtcli.compiled import query
         from rtcli.compiled.pack import geometry
         if self._geometry is None:
@@ -91,22 +97,22 @@ class Accelerator:
         n = o.shape[1]
         t, obj, prim = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
         lo, hi = (np.broadcast_to(np.asarray(x, float), (n,)).copy() for x in (t_min, t_max))
-        query.WALK_RAYS_OBJECTS(geo, 0, np.ascontiguousarray(o), np.ascontiguousarray(d), lo, hi, shadow,
+        query.WALK_RAYS_OBJECTS(geo, 0, np.ascontiguousarray(o), np.ascontiguousarray(d), lo, hi, mode,
                                 t, obj, prim, np.empty(depth, np.int64))
         return t, obj, prim
 
-    def first_hit(self, scene, rays, t_min):
-        """find_first_hit through the BVH."""
+    def first_hit(self, scene, rays, t_min, t_max=np.inf, casters: bool = False):
+        """find_first_hit through the BVH (with `casters`, among the objects that cast shadows)."""
         o, d = rays.o, rays.d
-        hits = no_hits(len(rays))
-        nearest_over(scene, self.unbounded, rays, t_min, hits)
+        hits = no_hits(len(rays), t_max)
+        nearest_over(scene, self.unbounded, rays, t_min, hits, casters)
         if variants.ENABLED and self.all_spheres:
-            t, obj, sub = self._walk(scene, o, d, t_min, hits.t, False)
+            t, obj, sub = self._walk(scene, o, d, t_min, hits.t, NEAREST_CASTER if casters else NEAREST)
             won = obj >= 0
             hits.t[won], hits.obj[won], hits.prim[won] = t[won], obj[won], sub[won]
             return hits
         sub = np.zeros(len(rays), dtype=np.int64)      # which face of the winning object (0 for spheres)
-        pairs = lambda r, m, t_max: self._pair_test(scene, o, d, t_min, r, m, t_max)
+        pairs = lambda r, m, t_max: self._pair_test(scene, o, d, t_min, r, m, t_max, casters)
         t, member = self.bvh.intersect(o, d, t_min, hits.t, pairs, sub)
         won = member >= 0
         hits.t[won], hits.obj[won], hits.prim[won] = t[won], self.members[member[won]], sub[won]
@@ -120,7 +126,7 @@ class Accelerator:
         todo = np.flatnonzero(~blocked)
         p, dt = points[:, todo], d[:, todo]
         if variants.ENABLED and self.all_spheres:
-            blocked[todo] = self._walk(scene, p, dt, 0.0, 1.0, True)[1] >= 0
+            blocked[todo] = self._walk(scene, p, dt, 0.0, 1.0, ANY_CASTER)[1] >= 0
         else:
             blocked[todo] = self.bvh.any_hit(p, dt, 0.0, 1.0, lambda r, m, t_max: self._pair_blocks(scene, p, dt, r, m))
         return blocked

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli import variants
-from rtcli.core.bvh import slab
+from rtcli.core.bvh import ANY_CASTER, NEAREST, slab
+from rtcli.core.dielectric import FEELER_CROSSINGS
 from rtcli.core.scene import Scene
 from rtcli.core.shading import facing
 from rtcli.core.textures import IMAGE, KIND, texture_color
@@ -40,6 +41,7 @@ class Surface:
     n: np.ndarray           # (3, n) unit shading normal, turned to face the incoming ray
     ng: np.ndarray          # (3, n) unit geometric normal, same side as n (for offsets)
     entering: np.ndarray    # (n,) the ray arrives on the outside (d . outward normal < 0)
+    obj: np.ndarray         # (n,) index into scene.objects (which solid a refracted ray enters or leaves)
     material: np.ndarray    # (n,) row of the MaterialTable
     texture: np.ndarray     # (3, n) texture color T (1 without a texture)
 
@@ -71,7 +73,8 @@ def _compiled_walk(shape, o, d, t_min, t_max, shadow: bool):
     geo = _GEOMETRY[shape]
     t, face, prim = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
     lo, hi = (np.broadcast_to(np.asarray(x, float), (n,)).copy() for x in (t_min, t_max))
-    query.WALK_RAYS_TRIANGLES(geo, 0, np.ascontiguousarray(o), np.ascontiguousarray(d), lo, hi, shadow,
+    query.WALK_RAYS_TRIANGLES(geo, 0, np.ascontiguousarray(o), np.ascontiguousarray(d), lo, hi,
+                              ANY_CASTER if shadow else NEAREST,
                               t, face, prim, np.empty(shape.bvh.depth + 2, np.int64))
     return (face >= 0) if shadow else (t, face)
 
@@ -109,14 +112,24 @@ def reciprocal(d):
         return 1.0 / d
 
 
-def nearest_over(scene: Scene, indices, rays: Rays, t_min: float, best: Hits) -> None:
-    """Lower `best` to the nearest hit among the objects `indices`, each tested only on
-    the rays that meet its bounding box before the best hit so far."""
+def casts(scene: Scene, k: int) -> bool:
+    """Whether object k stops or filters shadow feelers."""
+    return bool(scene.materials.shadow[scene.objects[k].material])
+
+
+def nearest_over(scene: Scene, indices, rays: Rays, t_min, best: Hits, casters: bool = False) -> None:
+    """Lower `best` to the nearest hit among the objects `indices` (with `casters`, those that
+    cast shadows), each tested only on the rays that meet its bounding box before the best hit so
+    far. t_min: a number, or one per ray."""
     inv, every = reciprocal(rays.d), np.arange(len(rays))
+    t_min = np.asarray(t_min, dtype=float)
     for k in indices:
+        if casters and not casts(scene, k):
+            continue
         rows = _candidates(scene, k, rays.o, inv, every, best.t)
         if len(rows):
-            t, prim = object_hit(scene.objects[k], rays.o[:, rows], rays.d[:, rows], t_min, best.t[rows])
+            low = t_min if t_min.ndim == 0 else t_min[rows]
+            t, prim = object_hit(scene.objects[k], rays.o[:, rows], rays.d[:, rows], low, best.t[rows])
             closer = t < best.t[rows]
             won = rows[closer]
             best.t[won], best.obj[won], best.prim[won] = t[closer], k, prim[closer]
@@ -127,23 +140,28 @@ def blocked_by(scene: Scene, indices, points: np.ndarray, d: np.ndarray, blocked
     blocks; a feeler stops at its first blocker: later objects test only the open ones."""
     inv = reciprocal(d)
     for k in indices:
-        if scene.materials.shadow[scene.objects[k].material]:
+        if casts(scene, k):
             todo = _candidates(scene, k, points, inv, np.flatnonzero(~blocked), 1.0)
             if len(todo):
                 blocked[todo] = blocks(scene.objects[k], points[:, todo], d[:, todo], 0.0, 1.0)
 
 
-def no_hits(n: int) -> Hits:
-    return Hits(np.full(n, np.inf), np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=np.int64))
+def no_hits(n: int, t_max=np.inf) -> Hits:
+    """No hit yet: t = t_max (a number or one per ray), object -1."""
+    t = np.broadcast_to(np.asarray(t_max, dtype=float), (n,)).copy()
+    return Hits(t, np.full(n, -1, dtype=np.int64), np.zeros(n, dtype=np.int64))
 
 
-def find_first_hit(scene: Scene, rays: Rays, t_min: float = 0.0) -> Hits:
-    """Nearest hit over all objects: through the BVH when the scene has one, else
-    object by object, each tested only on the rays that meet its bounding box."""
+def find_first_hit(scene: Scene, rays: Rays, t_min=0.0, t_max=np.inf, casters: bool = False) -> Hits:
+    """Nearest hit in (t_min, t_max) over all objects (with `casters`, over those that cast
+    shadows): through the BVH when the scene has one, else object by object, each tested only
+    on the rays that meet its bounding box. Misses have t = inf."""
     if scene.accel is not None:
-        return scene.accel.first_hit(scene, rays, t_min)
-    best = no_hits(len(rays))
-    nearest_over(scene, range(len(scene.objects)), rays, t_min, best)
+        best = scene.accel.first_hit(scene, rays, t_min, t_max, casters)
+    else:
+        best = no_hits(len(rays), t_max)
+        nearest_over(scene, range(len(scene.objects)), rays, t_min, best, casters)
+    best.t[best.obj < 0] = np.inf
     return best
 
 
@@ -155,6 +173,40 @@ def occluded(scene: Scene, points: np.ndarray, lights: np.ndarray) -> np.ndarray
     blocked = np.zeros(points.shape[1], dtype=bool)
     blocked_by(scene, range(len(scene.objects)), points, lights - points, blocked)
     return blocked
+
+
+def transmittance(scene: Scene, points: np.ndarray, lights: np.ndarray) -> np.ndarray:
+    """(3, n): how much of each light reaches each point along the feeler p + t (l - p), 0 < t < 1.
+    An object that casts a full shadow stops it (0); one with `shadow: filter` lets it through,
+    times its material's kt at each surface crossed (docs/scene-format.md, Shading), up to
+    FEELER_CROSSINGS crossings. Without such materials this is occluded(), as 0 or 1."""
+    n = points.shape[1]
+    if not scene.materials.filters.any():
+        return np.repeat((~occluded(scene, points, lights)).astype(float)[None], 3, axis=0)
+    T, d, t0, todo = np.ones((3, n)), lights - points, np.zeros(n), np.arange(n)
+    for _ in range(FEELER_CROSSINGS):
+        hits = find_first_hit(scene, Rays(points[:, todo], d[:, todo]), t0[todo], 1.0, casters=True)
+        got = np.isfinite(hits.t)
+        todo, hits = todo[got], hits[got]
+        if not len(todo):
+            return T
+        material = hit_materials(scene, hits)
+        clear = scene.materials.filters[material]
+        T[:, todo[~clear]] = 0.0
+        T[:, todo[clear]] *= scene.materials.kt[material[clear]].T
+        t0[todo[clear]] = hits.t[clear]
+        todo = todo[clear]
+    T[:, todo] = 0.0
+    return T
+
+
+def hit_materials(scene: Scene, hits: Hits) -> np.ndarray:
+    """The material of each hit (a csg's child may have its own)."""
+    out = np.empty(len(hits.t), dtype=np.int64)
+    for k in np.unique(hits.obj):
+        rows = hits.obj == k
+        out[rows] = scene.objects[k].shape.material_of(hits.prim[rows], scene.objects[k].material)
+    return out
 
 
 def surface(scene: Scene, rays: Rays, hits: Hits) -> Surface:
@@ -172,7 +224,7 @@ def surface(scene: Scene, rays: Rays, hits: Hits) -> Surface:
         _object_surface(scene, scene.objects[k], rays, hits, rows, normal, geometric, material, texture)
     with np.errstate(invalid="ignore"):
         nx, ny, nz, gx, gy, gz, entering = facing(*rays.d, *normal, *geometric)
-    return Surface(p, np.array([nx, ny, nz]), np.array([gx, gy, gz]), entering, material, texture)
+    return Surface(p, np.array([nx, ny, nz]), np.array([gx, gy, gz]), entering, hits.obj, material, texture)
 
 
 def _object_surface(scene, obj, rays, hits, rows, normal, geometric, material, texture) -> None:
@@ -187,6 +239,18 @@ def _object_surface(scene, obj, rays, hits, rows, normal, geometric, material, t
     with np.errstate(invalid="ignore", divide="ignore"):
         normal[:, rows], geometric[:, rows], material[rows] = unit(*ns), unit(*ng), mat
     fill_texture(scene, p_obj, lambda sel: obj.shape.uv_at(p_obj[:, sel], prim[sel]), mat, texture, rows)
+
+
+def uv_at_hits(scene: Scene, rays: Rays, hits: Hits) -> np.ndarray:
+    """(2, n) the texture coordinates (u, v) of each hit, whether or not its material has a texture."""
+    uv = np.empty((2, len(rays)))
+    for k in np.unique(hits.obj):
+        rows = np.flatnonzero(hits.obj == k)
+        obj = scene.objects[k]
+        o_obj, d_obj = to_object(obj, rays.o[:, rows], rays.d[:, rows])
+        u, v = obj.shape.uv_at(o_obj + hits.t[rows] * d_obj, hits.prim[rows])
+        uv[:, rows] = np.broadcast_arrays(u, v, rows)[:2]
+    return uv
 
 
 def fill_texture(scene, p_obj, uv_of, mat, texture, rows) -> None:

@@ -1,0 +1,68 @@
+"""The JUnit XML file of `rtcli compare ... --junit FILE`, which CI systems show as test results.
+
+One test suite, one test case per pair (named by its relative path): an ok pair
+passes, a failing, missing or extra one is a <failure> whose message is its summary
+line, an unreadable one an <error>. The file follows the Apache Ant JUnit schema,
+the strictest of the common ones (every attribute it requires, <properties>,
+<system-out> and <system-err>), so the looser readers of GitLab, Jenkins or GitHub
+actions read it too. Text is kept on one line and free of the control characters
+XML cannot hold (errors.one_line).
+"""
+
+from __future__ import annotations
+
+import datetime
+import os
+import socket
+import tempfile
+import xml.etree.ElementTree as ET
+
+from rtcli.errors import RtcliError, one_line, shown
+from rtcli.folders import Pair, counts, total_line
+from rtcli.writer import current_umask
+
+
+def junit_xml(pairs: list[Pair], properties: dict[str, str], seconds: float) -> bytes:
+    """The document, as UTF-8 bytes."""
+    c = counts(pairs)
+    suite = ET.Element("testsuite", {
+        "name": "rtcli compare", "package": "rtcli", "id": "0",
+        "timestamp": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%S"),
+        "hostname": one_line(socket.gethostname()) or "localhost",
+        "tests": str(len(pairs)), "failures": str(c["failing"] + c["missing"] + c["extra"]),
+        "errors": str(c["unreadable"]), "skipped": "0", "time": f"{seconds:.3f}"})
+    listed = ET.SubElement(suite, "properties")
+    for name, value in properties.items():
+        ET.SubElement(listed, "property", {"name": name, "value": one_line(value)})
+    for pair in pairs:
+        case = ET.SubElement(suite, "testcase", {"name": one_line(pair.path), "classname": "rtcli.compare",
+                                                 "time": f"{pair.seconds:.3f}"})
+        if not pair.ok:
+            kind = "error" if pair.status == "unreadable" else "failure"
+            result = ET.SubElement(case, kind, {"message": one_line(pair.summary), "type": pair.status})
+            result.text = one_line(pair.summary)
+    ET.SubElement(suite, "system-out").text = total_line(pairs)
+    ET.SubElement(suite, "system-err").text = ""
+    root = ET.Element("testsuites")
+    root.append(suite)
+    ET.indent(root)
+    return ET.tostring(root, encoding="utf-8", xml_declaration=True) + b"\n"
+
+
+def write_junit(path: str, data: bytes) -> None:
+    """Write the file atomically (a temporary file beside it, then a rename)."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".rtcli-", suffix=".xml", dir=os.path.dirname(os.path.abspath(path)))
+    except OSError as e:
+        raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.chmod(tmp, 0o666 & ~current_umask())
+        os.replace(tmp, path)
+    except BaseException as e:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        if isinstance(e, OSError):
+            raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
+        raise

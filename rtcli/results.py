@@ -1,0 +1,126 @@
+"""What the Python API returns: images that are numpy arrays, and the statistics of a render.
+
+An ImageArray is a numpy array (anything that takes an array takes it) that also
+shows itself inline in Jupyter (`_repr_png_`), converts to a Pillow image and saves
+through the command line's writer, with its output checks (docs/python-api.md).
+Three kinds come out of rtcli.render and rtcli.signature:
+
+    uint8 (H, W, 3)     the image as `rtcli render` writes it
+    float64 (H, W, 3)   the linear colors traced (render(..., linear=True)): unclamped,
+                        to_8bit() of them is the 8-bit image, exactly
+    uint16 (H, W)       signature ids: 0 for the background, else the object's id
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class RenderStats:
+    """Rays traced by kind, the engine that traced them, and how long it took."""
+
+    width: int                       # the image rendered, in pixels
+    height: int
+    samples: int                     # n x n per pixel
+    engine: str                      # "numpy" or "compiled"
+    primary: int                     # rays by kind
+    shadow: int
+    reflected: int
+    refracted: int
+    seconds: float                   # wall time of the render (tiles traced and assembled)
+
+    @property
+    def total(self) -> int:
+        return self.primary + self.shadow + self.reflected + self.refracted
+
+    @property
+    def rays_per_second(self) -> float:
+        return self.total / max(self.seconds, 1e-9)
+
+    def as_dict(self) -> dict:
+        """The fields, total and rays_per_second: what `rtcli render --stats --json` prints."""
+        return {**asdict(self), "seconds": round(self.seconds, 6), "total": self.total,
+                "rays_per_second": round(self.rays_per_second)}
+
+    def line(self, seconds: float | None = None) -> str:
+        """The one line of `rtcli render --stats` (over `seconds`, when another span is meant)."""
+        s = self.seconds if seconds is None else seconds
+        return (f"rays: {self.primary} primary, {self.shadow} shadow, {self.reflected} reflected, "
+                f"{self.refracted} refracted, {self.total} total; {self.engine} engine; {s:.2f} s; "
+                f"{self.total / max(s, 1e-9):,.0f} rays/s")
+
+
+class ImageArray(np.ndarray):
+    """A rendered image or id map: a numpy array that shows itself in Jupyter and saves itself.
+
+    `stats` is the RenderStats of the render that made it (None on arrays derived from it);
+    `inputs` the files the scene read, which save() refuses to overwrite; `picture` how a
+    debug view (rtcli.view) shows, 8-bit (None for images, which show as themselves).
+    """
+
+    stats: RenderStats | None
+    inputs: tuple[str, ...]
+    picture: np.ndarray | None
+
+    def __new__(cls, pixels, stats: RenderStats | None = None, inputs=(), picture=None) -> ImageArray:
+        image = np.asarray(pixels).view(cls)
+        image.stats, image.inputs, image.picture = stats, tuple(inputs), picture
+        return image
+
+    def __array_finalize__(self, obj) -> None:
+        self.stats, self.inputs, self.picture = None, getattr(obj, "inputs", ()), None
+
+    @property
+    def is_ids(self) -> bool:
+        """Whether this is a signature id map (uint16 (H, W))."""
+        return self.ndim == 2 and self.dtype == np.uint16
+
+    def to_8bit(self, gamma: bool = False) -> ImageArray:
+        """The 8-bit image: linear colors clamped to [0, 1], optionally sRGB-encoded, rounded; an id
+        map as its signature picture (a fixed color per id, as `rtcli signature` draws it); a
+        debug view as its picture."""
+        from rtcli.writer import signature_colors, to_8bit
+        if self.picture is not None:
+            return ImageArray(self.picture, inputs=self.inputs)
+        if self.is_ids:
+            return ImageArray(signature_colors(np.asarray(self)), inputs=self.inputs)
+        if self.ndim != 3 or self.shape[2] != 3:
+            raise ValueError(f"not an image: an array of shape {self.shape}")
+        if self.dtype == np.uint8:
+            return self
+        return ImageArray(to_8bit(np.asarray(self, dtype=float), gamma), inputs=self.inputs)
+
+    def to_pil(self):
+        """A Pillow image: RGB for colors (linear ones converted by to_8bit()), 16-bit gray for ids."""
+        from PIL import Image
+        return Image.fromarray(np.asarray(self if self.is_ids else self.to_8bit()))
+
+    def save(self, path: str) -> None:
+        """Write the image as `rtcli render` (or an id map as `rtcli signature --ids`) would: the format
+        follows the extension, the file is replaced atomically, and an input of the scene, a
+        folder or a device is refused (RtcliError)."""
+        from rtcli.outputs import check_outputs
+        from rtcli.writer import write_png
+        path = str(path)
+        check_outputs([(path, self.is_ids)], list(self.inputs))
+        write_png(path, np.asarray(self if self.is_ids else self.to_8bit()))
+
+    def _repr_png_(self) -> bytes | None:
+        """PNG bytes for Jupyter: the 8-bit image, or the signature picture of ids; None (plain text)
+        for an array that is neither."""
+        if not (self.picture is not None or self.is_ids
+                or (self.ndim == 3 and self.shape[2] == 3 and self.dtype.kind in "uf")):
+            return None
+        return png_bytes(np.asarray(self.to_8bit()))
+
+
+def png_bytes(pixels: np.ndarray) -> bytes:
+    """An 8-bit image encoded as PNG, in memory."""
+    from PIL import Image
+    buffer = io.BytesIO()
+    Image.fromarray(pixels).save(buffer, format="PNG")
+    return buffer.getvalue()
