@@ -15,6 +15,7 @@ from rtcli.core import camera as cameras
 from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
+from rtcli.errors import SceneError
 from rtcli.scenefile import yamlfile
 from rtcli.scenefile.files import recording_inputs
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
@@ -63,6 +64,8 @@ def scene_from_docs(docs: list) -> Scene:
     """Included documents first, the main file last; only the main file sets camera and image."""
     params = [Params(doc, "") for doc in docs]
     main = params[-1]
+    main.known("version", "include", "image", "camera", "background", "ambient", "render",
+               "lights", "materials", "objects")
     for p in params:
         if p.has("version") and p.raw("version") != 1:
             raise p.error("version", f"unsupported version {describe(p.raw('version'))} (this is version 1)")
@@ -117,11 +120,23 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
                  ambient=p.color("ambient", (0.1, 0.1, 0.1)), settings=settings, eye=eye)
 
 
+CAMERA_FORMS = {"fov": ("eye", "look_at", "up", "fov"),           # the keys of each camera form
+                "window": ("eye", "look_at", "up", "focal", "window"),
+                "screen": ("eye", "screen")}
+
+
 def camera_from(c: Params):
     """One of the three camera forms; returns (callable (nc, nr) -> Camera, eye)."""
+    c.known("eye", "look_at", "up", "fov", "focal", "window", "screen")
+    form = "screen" if c.has("screen") else "window" if c.has("window") else "fov"
+    for key in c.node:
+        if key in c.read and key not in CAMERA_FORMS[form]:
+            raise SceneError(c.node.key_where[key], c.key_path(key), f"the {form} form of the camera takes "
+                             f"no {key} (it takes {', '.join(CAMERA_FORMS[form])}; docs/scene-format.md, Camera)")
     eye = c.vector("eye")
-    if c.has("screen"):
+    if form == "screen":
         s = c.sub("screen")
+        s.known("lower_left", "horizontal", "vertical")
         ll, h, v = s.vector("lower_left"), s.vector("horizontal"), s.vector("vertical")
         s.check_unused()
         if np.linalg.norm(np.cross(h, v)) == 0:
@@ -135,9 +150,10 @@ def camera_from(c: Params):
         if c.has("up"):
             raise c.error("up", "must not be parallel to the view direction (look_at - eye)")
         raise c.error(None, "the default up [0, 1, 0] is parallel to the view direction; give camera.up")
-    if c.has("window"):
+    if form == "window":
         focal = c.number("focal", 1.0, positive=True)
         w = c.sub("window")
+        w.known("left", "right", "top", "bottom")
         wl, wr, wt, wb = (w.number(k) for k in ("left", "right", "top", "bottom"))
         w.check_unused()
         if wl == wr or wt == wb:
@@ -169,6 +185,7 @@ def check_resolvable(p: Params, camera, width: int, height: int) -> None:
 
 
 def light_from(p: Params) -> PointLight:
+    p.known("position", "color", "attenuation", "spot", "area")
     position, color = p.vector("position"), p.color("color", (1.0, 1.0, 1.0))
     att = p.numbers("attenuation", 3, (1.0, 0.0, 0.0), "[c0, c1, c2]")
     if np.any(att < 0) or not np.any(att):
@@ -176,6 +193,7 @@ def light_from(p: Params) -> PointLight:
     extra = {}
     s = p.optional("spot")
     if s is not None:
+        s.known("direction", "angle", "falloff")
         direction = s.vector("direction")
         if not np.any(direction):
             raise s.error("direction", "must not be the zero vector")
@@ -188,6 +206,7 @@ def light_from(p: Params) -> PointLight:
         s.check_unused()
     a = p.optional("area")
     if a is not None:
+        a.known("u", "v", "samples")
         extra.update(area_u=a.vector("u"), area_v=a.vector("v"), area_samples=a.integer("samples", 3, 1, 16))
         a.check_unused()
     p.check_unused()
