@@ -265,10 +265,27 @@ def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
 
 @main.command()
 @click.argument("scene_file", metavar="SCENE.yaml")
-def validate(scene_file):
-    """Parse and check a scene; print a summary. Renders nothing."""
+@click.option("--objects", "list_objects", is_flag=True,
+              help="List every object: id, name, shape, material, shadow, triangles, world-space bounds.")
+@click.option("--strict", is_flag=True, help="Warnings are errors (exit 2).")
+def validate(scene_file, list_objects, strict):
+    """Parse and check a scene; print a summary, and warnings about likely mistakes on stderr.
+    Renders only a small signature (does the camera see anything?)."""
+    from rtcli import checks
     from rtcli.scenefile.build import summary
-    click.echo(f"{shown(scene_file)}: ok: {summary(_load(scene_file)[0])}")
+    from rtcli.scenefile.remarks import recording_remarks
+    with recording_remarks() as remarks:
+        scene = _load(scene_file)[0]
+    found = checks.warnings(scene, remarks)
+    if strict and found:
+        more = f" (and {len(found) - 1} more warnings)" if len(found) > 1 else ""
+        raise RtcliError(f"{found[0].where}: {found[0].message}{more}")
+    click.echo(f"{shown(scene_file)}: ok: {summary(scene)}")
+    if list_objects:
+        for line in checks.object_lines(checks.object_rows(scene, remarks)):
+            click.echo(line)
+    for remark in found:
+        click.echo(one_line(str(remark)), err=True)
 
 
 @main.command()

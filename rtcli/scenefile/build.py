@@ -16,7 +16,7 @@ from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
 from rtcli.errors import SceneError
-from rtcli.scenefile import yamlfile
+from rtcli.scenefile import remarks, yamlfile
 from rtcli.scenefile.files import recording_inputs
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
 from rtcli.scenefile.objects import ObjectBuilder, material_from
@@ -75,16 +75,32 @@ def scene_from_docs(docs: list) -> Scene:
         for name, mp in _materials(p):
             named[name] = len(table)
             table.append(material_from(mp))
-    builder, lights = ObjectBuilder(named, table, 0), []
+    builder, lights, places = ObjectBuilder(named, table, 0), [], []
     for p in params:
-        lights += [light_from(as_params(item, where, path, "a light mapping"))
-                   for item, where, path in p.items("lights", [])]
+        for item, where, path in p.items("lights", []):
+            lights.append(light_from(as_params(item, where, path, "a light mapping")))
+            places.append(remarks.at(where, path))
         builder.add_all(p.items("objects", []))
     for p in params[:-1]:
         p.check_unused()
     scene = _top_level(main, builder, lights, table)
     main.check_unused()
+    if (record := remarks.current()) is not None:
+        _remember(record, params, named, places)
     return scene
+
+
+def _remember(record: remarks.Remarks, params: list[Params], named: dict, places: list[str]) -> None:
+    """For `rtcli validate`: where the camera, the lights and the objects are written, and the
+    materials' names."""
+    main = params[-1]
+    record.camera = remarks.at(main.node.value_where.get("camera", main.where), "camera")
+    record.lights = places
+    for key in ("lights", "objects"):
+        given = [p for p in params if p.has(key)]
+        place = remarks.at(given[-1].node.value_where[key] if given else main.where, key)
+        setattr(record, f"{key}_key", place)
+    record.materials = {row: name for name, row in named.items()}
 
 
 def _materials(p: Params):

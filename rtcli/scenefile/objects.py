@@ -281,7 +281,7 @@ class ObjectBuilder:
         else:
             shape = self.shape(p, kind, material)
             self.objects.append(SceneObject(len(self.objects) + 1, p.node.get("name", ""), shape,
-                                            material, world, kind))
+                                            material, world, kind, f"{p.where}: {p.path}"))
         p.check_unused()
 
     def shape(self, p: Params, kind: str, material: int):

@@ -18,6 +18,7 @@ import numpy as np
 from rtcli.errors import SceneError, Where, quoted, shown
 from rtcli.scenefile.limits import MAX_MAGNITUDE, RANGE
 from rtcli.scenefile.nodes import CommentedColor
+from rtcli.scenefile.remarks import note_color
 from rtcli.scenefile.yamlfile import MapNode, SeqNode
 
 REQUIRED = object()
@@ -244,6 +245,7 @@ class Params:
                 except ValueError:
                     pass
             raise SceneError(where, label, f"must be a color [r, g, b] or \"#rrggbb\", got {describe(x)}")
+        written = x
         if allow_scalar and _is_number(x):
             x = [x, x, x]
         if not isinstance(x, list) or len(x) != 3:
@@ -252,6 +254,7 @@ class Params:
             if (why := _channel_problem(v, at_most)) is not None:
                 item_where = x.item_where[k] if isinstance(x, SeqNode) else where
                 raise SceneError(item_where, f"{label}[{k}]", why)
+        note_color(written, where, label)
         return np.array(x, dtype=float)
 
     def coefficient(self, key, default=REQUIRED, at_most=None) -> np.ndarray:
