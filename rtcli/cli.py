@@ -12,6 +12,7 @@ import os
 import signal
 import sys
 import threading
+import time
 
 import click
 
@@ -136,8 +137,10 @@ def _progress(enabled: bool, label: str):
 @click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
               help="numpy core, or compiled integrator (numba); auto: compiled for big jobs it can render.")
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects: test each against every ray (for comparisons).")
+@click.option("--watch", is_flag=True, help="Render again whenever the scene or a file it reads changes; "
+                                            "print each render's time; Ctrl-C ends.")
 def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
-           gamma, quiet, progress, stats, as_json, engine, no_bvh):
+           gamma, quiet, progress, stats, as_json, engine, no_bvh, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format); several
     scenes, or a folder of them, to a folder of images."""
     from rtcli import api, batch
@@ -145,18 +148,39 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
         raise click.UsageError("--json goes with --stats")
     api.check_engine(engine)
     items, folder = batch.plan(list(scene_files), output)
+    if watch and folder is not None:
+        raise click.UsageError("--watch renders one scene file")
     bar = not quiet and (progress or sys.stderr.isatty())
     note = lambda text: click.echo(f"note: {text}", err=True)                  # noqa: E731
+    load = lambda path: api.load_scene(path, samples=samples, max_depth=max_depth)      # noqa: E731
 
-    def render_one(scene, label):
+    def render_one(scene, label, out=None):
         api.image_size(scene.model, width, height, ("--width", "--height"))      # the options' names in errors
         return api.render(scene, width=width, height=height, engine=engine, workers=workers,
-                          block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh,
+                          block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh, output=out,
                           progress=_progress(bar, one_line(label)), notes=note)
-    done = batch.run(items, folder, lambda path: api.load_scene(path, samples=samples, max_depth=max_depth),
-                     render_one)
+    if watch:
+        return _watch(items[0], load, render_one, stats, as_json)
+    done = batch.run(items, folder, load, render_one)
     for line in batch.stats_lines(done, as_json, folder is not None) if stats else ():
         click.echo(line)
+
+
+def _watch(item, load, render_one, stats: bool, as_json: bool) -> None:
+    """render --watch: the scene to its image now and after every change, until Ctrl-C."""
+    from rtcli import batch
+    from rtcli.watch import watch
+
+    def once() -> None:
+        start = time.perf_counter()
+        image = render_one(load(item.scene), os.path.basename(item.scene), item.output)
+        seconds = time.perf_counter() - start
+        click.echo(f"{time.strftime('%H:%M:%S')} rendered {shown(item.output)} "
+                   f"({image.stats.width}x{image.stats.height}) in {seconds:.2f} s")
+        for line in batch.stats_lines([(item, image.stats, seconds)], as_json, False) if stats else ():
+            click.echo(line)
+    click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends")
+    watch(item.scene, once, lambda line: click.echo(line, err=True))
 
 
 @main.command()

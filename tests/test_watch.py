@@ -1,0 +1,138 @@
+"""`rtcli render --watch`: a real process that renders, re-renders on edits of the scene and of
+what it includes, prints a broken edit's error and goes on, and ends on Ctrl-C.
+
+Waits poll the process's output with generous deadlines (the machine is shared); no
+assertion is about time.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from rtcli import api
+from rtcli.cli import main
+from rtcli.watch import watch
+
+SCENE = """\
+include: [mat.yaml]
+image: {width: 32, height: 24}
+camera: {eye: [0, 0, 5], look_at: [0, 0, 0], fov: 40}
+lights: [{position: [0, 0, 5]}]
+ambient: [0, 0, 0]
+objects:
+  - {name: ball, sphere: {radius: %s}, material: paint}
+"""
+PAINT = "materials:\n  paint: {diffuse: %s}\n"
+DEADLINE = 60                                 # seconds; a first render takes about one
+
+
+def wait_for(what, proc, deadline=DEADLINE):
+    """Poll until what() is true; fail (killing the process) if the deadline passes or it ends."""
+    end = time.monotonic() + deadline
+    while not what():
+        if proc.poll() is not None or time.monotonic() > end:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+            pytest.fail(f"gave up waiting (exit code {proc.returncode})")
+        time.sleep(0.05)
+
+
+def pixel(path, row: int = 12) -> str:
+    """The color of the image's pixel (row, 16): red, green or black."""
+    with Image.open(path) as img:
+        r, g, b = (int(c) for c in np.asarray(img)[row, 16])
+    names = {(True, False, False): "red", (False, True, False): "green", (False, False, False): "black"}
+    return names.get((r > 100, g > 100, b > 100), "?") if sorted((r, g, b))[1] == 0 else "?"
+
+
+@pytest.mark.skipif(os.name != "posix", reason="signals a process group")
+def test_watch_renders_each_edit_reports_errors_and_ends_on_ctrl_c(tmp_path):
+    work, logs = tmp_path / "work", tmp_path / "logs"
+    work.mkdir(), logs.mkdir()
+    (work / "s.yaml").write_text(SCENE % 1)
+    (work / "mat.yaml").write_text(PAINT % "[1, 0, 0]")
+    out, err = open(logs / "out", "w"), open(logs / "err", "w")
+    proc = subprocess.Popen([sys.executable, "-m", "rtcli", "render", "s.yaml", "--watch", "--workers", "1",
+                             "--engine", "numpy"], cwd=work, stdout=out, stderr=err, start_new_session=True)
+    rendered = lambda: (logs / "out").read_text().count(" rendered s.png (32x24) in ")    # noqa: E731
+    try:
+        wait_for(lambda: rendered() == 1, proc)
+        assert pixel(work / "s.png") == "red"
+
+        (work / "mat.yaml").write_text(PAINT % "[0, 1, 0]")             # an included file changes
+        wait_for(lambda: rendered() == 2, proc)
+        assert pixel(work / "s.png") == "green"
+
+        (work / "s.yaml").write_text((SCENE % 1).replace("radius", "raduis"))      # a broken edit
+        wait_for(lambda: "raduis" in (logs / "err").read_text(), proc)
+        assert (logs / "err").read_text() == ("error: s.yaml:7:27: objects[0].sphere.raduis: unknown key "
+                                              "(did you mean 'radius'?); allowed here: center, radius\n")
+        assert proc.poll() is None and pixel(work / "s.png") == "green"       # still watching, image kept
+
+        (work / "s.yaml").write_text(SCENE % 0.3)                          # fixed: a smaller ball
+        wait_for(lambda: rendered() == 3, proc)
+        assert pixel(work / "s.png") == "green" and pixel(work / "s.png", row=8) == "black"
+    finally:
+        os.killpg(proc.pid, signal.SIGINT)                                 # Ctrl-C in a terminal
+        try:
+            proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+        out.close(), err.close()
+    assert proc.returncode == 130
+    assert (logs / "err").read_text().splitlines()[-1] == "error: interrupted"
+    lines = (logs / "out").read_text().splitlines()
+    assert lines[0] == "watching s.yaml and the files it reads; Ctrl-C ends" and len(lines) == 4
+    assert sorted(os.listdir(work)) == ["mat.yaml", "s.png", "s.yaml"]          # no temporary file left
+
+
+def test_watch_waits_for_a_file_a_failed_load_looked_for(tmp_path):
+    """A scene that includes a file not there yet fails; creating the file renders it."""
+    (tmp_path / "s.yaml").write_text(SCENE % 1)
+    errors, loaded = [], []
+
+    def render():
+        loaded.append(api.load_scene(str(tmp_path / "s.yaml")))
+        raise KeyboardInterrupt                                            # ends the watch
+
+    def error(line):
+        errors.append(line)
+        (tmp_path / "mat.yaml").write_text(PAINT % "0.5")                 # made after the load looked for it
+    with pytest.raises(KeyboardInterrupt):
+        watch(str(tmp_path / "s.yaml"), render, error, poll=0.02)
+    assert errors == [f"error: {tmp_path}/s.yaml:1:11: include[0]: file not found: {tmp_path}/mat.yaml"]
+    assert len(loaded) == 1 and loaded[0].model.objects[0].name == "ball"
+
+
+def test_a_save_during_a_render_is_rendered_after_it(tmp_path):
+    """The files are stamped as the load reads them: an edit made while rendering is seen."""
+    (tmp_path / "s.yaml").write_text(SCENE % 1)
+    (tmp_path / "mat.yaml").write_text(PAINT % "0.5")
+    radii = []
+
+    def render():
+        radii.append(api.load_scene(str(tmp_path / "s.yaml")).model.objects[0].shape.radius)
+        if len(radii) == 2:
+            raise KeyboardInterrupt
+        (tmp_path / "s.yaml").write_text(SCENE % 0.5)                      # saved while "rendering"
+    with pytest.raises(KeyboardInterrupt):
+        watch(str(tmp_path / "s.yaml"), render, pytest.fail, poll=0.02)
+    assert radii == [1, 0.5]
+
+
+def test_watch_takes_one_scene(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for name in ("a.yaml", "b.yaml"):
+        (tmp_path / name).write_text(SCENE % 1)
+    result = CliRunner().invoke(main, ["render", "a.yaml", "b.yaml", "--watch"])
+    assert (result.exit_code, result.output) == (2, "error: --watch renders one scene file\n")
