@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import time
+import types
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from click.testing import CliRunner
 from PIL import Image
 
 from rtcli import api
+from rtcli import watch as watching
 from rtcli.cli import main
 from rtcli.watch import watch
 
@@ -96,7 +98,21 @@ def test_watch_renders_each_edit_reports_errors_and_ends_on_ctrl_c(tmp_path):
     assert sorted(os.listdir(work)) == ["mat.yaml", "s.png", "s.yaml"]          # no temporary file left
 
 
-def test_watch_waits_for_a_file_a_failed_load_looked_for(tmp_path):
+@pytest.fixture
+def patience(monkeypatch):
+    """The in-process watches below poll every 0.02 s; after 1,500 polls (half a minute) a test
+    that waits for a change never seen fails instead of hanging."""
+    polls = []
+
+    def sleep(seconds):
+        polls.append(seconds)
+        if len(polls) > 1500:
+            pytest.fail("the watch never saw the change")
+        time.sleep(seconds)
+    monkeypatch.setattr(watching, "time", types.SimpleNamespace(sleep=sleep))
+
+
+def test_watch_waits_for_a_file_a_failed_load_looked_for(tmp_path, patience):
     """A scene that includes a file not there yet fails; creating the file renders it."""
     (tmp_path / "s.yaml").write_text(SCENE % 1)
     errors, loaded = [], []
@@ -114,7 +130,7 @@ def test_watch_waits_for_a_file_a_failed_load_looked_for(tmp_path):
     assert len(loaded) == 1 and loaded[0].model.objects[0].name == "ball"
 
 
-def test_a_save_during_a_render_is_rendered_after_it(tmp_path):
+def test_a_save_during_a_render_is_rendered_after_it(tmp_path, patience):
     """The files are stamped as the load reads them: an edit made while rendering is seen."""
     (tmp_path / "s.yaml").write_text(SCENE % 1)
     (tmp_path / "mat.yaml").write_text(PAINT % "0.5")
