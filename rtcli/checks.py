@@ -101,15 +101,23 @@ def _limited(found: list[Remark], where: str, what: str) -> list[Remark]:
 
 # --- the camera ---
 def _camera_sees_something(scene: Scene) -> bool:
-    """Whether a signature render, SMALL then LARGER pixels on its long side, hits any object."""
-    from rtcli.render import Job, render
+    """Whether the primary rays through pixel centres, SMALL then LARGER pixels on the image's
+    long side, hit any object (the signature render's test, for any number of objects)."""
+    from rtcli import wavefront
+    from rtcli.render import camera_rays
+    from rtcli.wavefront.intersect import find_first_hit
     s = scene.settings
+    wavefront.prepare(scene)
     for size in (SMALL, LARGER):
         scale = min(1.0, size / max(s.width, s.height))
         w, h = max(1, round(s.width * scale)), max(1, round(s.height * scale))
-        ids, _ = render(scene, Job(w, h, signature=True))
-        if ids.any():
-            return True
+        cam = scene.camera(w, h)
+        for rows in np.array_split(np.arange(h), max(1, w * h // 16384)):         # about 16,384 rays at once
+            jj, ii = np.meshgrid(rows + 0.5, np.arange(w) + 0.5, indexing="ij")
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                hits = find_first_hit(scene, camera_rays(cam, ii.ravel(), jj.ravel(), w, h))
+            if np.isfinite(hits.t).any():
+                return True
         if scale == 1.0:
             break
     return False
