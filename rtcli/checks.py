@@ -1,11 +1,11 @@
-"""`rtcli validate`'s listing of objects and its warnings (README.md, Checks).
+"""`rtcli validate`'s listing of objects and its warnings (README.md, `validate`).
 
 A warning is a likely mistake that is not an error: the scene renders, but probably
 not as meant. Each is located where the scene file gives what it is about:
 
 - a color written as 0-255 values (recorded while loading, scenefile/remarks.py);
 - no lights; no objects;
-- a camera that sees no object: a small signature render is all background;
+- a camera that sees no object: no primary ray of a small image hits one;
 - a light inside a closed object that casts full shadows: it lights nothing outside;
 - an object no light reaches: at the nearest point of its box, every light's
   attenuated intensity max(I) / (c0 + c1 r + c2 r^2) is below 1/255 (the 8-bit step),
@@ -24,7 +24,7 @@ from rtcli.scenefile.remarks import Remark, Remarks
 
 SMALL = 64                         # the camera check's signature is SMALL pixels on its long side,
 LARGER = 512                       # then LARGER when that sees nothing (a small object can hide between rays)
-DARK = 1 / 255                     # below this a light changes no 8-bit pixel
+DARK = 1 / 255                     # less light than this adds less than one step to an 8-bit pixel
 LISTED = 20                        # warnings of one kind shown one by one; the rest are counted
 PROBE = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)     # a direction no box face is parallel to
 
@@ -43,6 +43,7 @@ class ObjectRow:
 
 
 def object_rows(scene: Scene, remarks: Remarks) -> list[ObjectRow]:
+    """One row per object, in id order."""
     rows = []
     for o in scene.objects:
         material = scene.materials.materials[o.material]

@@ -1,4 +1,4 @@
-"""`rtcli render --watch`: render a scene again whenever it or a file it reads changes (README.md, Watch).
+"""`rtcli render --watch`: render a scene again whenever it or a file it reads changes (README.md, `--watch`).
 
 The files are the scene, its includes, meshes and textures, and a file a failed load
 looked for and did not find (creating it is a change too). Loading stamps each one

@@ -337,11 +337,14 @@ REFERENCES = {
                        "scene.yaml:3:15: materials.m.preset: unknown preset 'brasss' "
                        "(did you mean 'brass'? `rtcli presets` lists them)"),
     "unknown_preset_far_off": (CAM + "materials:\n  m: {preset: velvet}\n",
-                               "scene.yaml:3:15: materials.m.preset: unknown preset 'velvet' (`rtcli presets` lists them)"),
+                               "scene.yaml:3:15: materials.m.preset: unknown preset 'velvet' "
+                               "(`rtcli presets` lists them)"),
     #          "    material: nope": value at 15
     "unknown_material": (obj("sphere: {}\n    material: nope"),
-                         "scene.yaml:4:15: objects[0].material: unknown material 'nope' (the scene defines no materials)"),
-    "misspelt_material": (CAM + "materials:\n  red: {diffuse: [1, 0, 0]}\nobjects:\n  - sphere: {}\n    material: rde\n",
+                         "scene.yaml:4:15: objects[0].material: unknown material 'nope' "
+                         "(the scene defines no materials)"),
+    "misspelt_material": (CAM + "materials:\n  red: {diffuse: [1, 0, 0]}\nobjects:\n"
+                          "  - sphere: {}\n    material: rde\n",
                           "scene.yaml:6:15: objects[0].material: unknown material 'rde' (did you mean 'red'?)"),
     "other_material": (CAM + "materials:\n  red: {diffuse: [1, 0, 0]}\n  blue: {diffuse: [0, 0, 1]}\n"
                        "objects:\n  - sphere: {}\n    material: green\n",

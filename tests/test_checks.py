@@ -87,7 +87,8 @@ def test_a_light_color_and_the_background_are_checked_too(validate):
     found = warnings_of(validate(CAM + "lights: [{position: [0, 5, 5], color: [255, 255, 255]}]\n"
                                        "background: [30, 30, 40]\nobjects: [{sphere: {}}]\n"))
     #      "lights: [{position: [0, 5, 5], color: [255, 255, 255]}]": '[' at 39
-    assert [line.split(": warning:")[0] for line in found] == ["s.yaml:3:39: lights[0].color", "s.yaml:4:13: background"]
+    assert [line.split(": warning:")[0] for line in found] == ["s.yaml:3:39: lights[0].color",
+                                                                "s.yaml:4:13: background"]
 
 
 # --- lights, camera, objects ---
@@ -150,7 +151,8 @@ def test_the_light_inside_warning_names_the_light_and_the_object(validate):
     ("{position: [-1200, 5, 0], attenuation: [1, 0, 0.1], area: {u: [400, 0, 0], v: [0, 0, 1]}}", False),
 ])
 def test_an_object_out_of_every_lights_reach(validate, light, warned):
-    text = CAM + f"lights: [{light}]\nobjects:\n  - {{sphere: {{}}}}\n  - {{name: far, sphere: {{center: [-1000, 0, 0]}}}}\n"
+    text = (CAM + f"lights: [{light}]\n" +
+            "objects:\n  - {sphere: {}}\n  - {name: far, sphere: {center: [-1000, 0, 0]}}\n")
     found = [w for w in warnings_of(validate(text)) if "objects[1]" in w]
     assert found == (["s.yaml:6:5: objects[1]: warning: no light reaches it: each light's attenuated intensity at "
                       "its box is below 1/255, or a spot light's cone misses it"] if warned else []), found

@@ -1,4 +1,4 @@
-"""What loading a scene remembers for `rtcli validate` (README.md, Checks): where the camera
+"""What loading a scene remembers for `rtcli validate` (README.md, `validate`): where the camera
 and each light are written, the names of the materials, and values that load but look like
 mistakes (colors written as 0-255 values).
 
