@@ -8,8 +8,10 @@ is seen when it ends. A change is rendered once the files have held still for on
 so a save caught half-written is not read.
 
 Every render runs in this process, so the compiled engine's machine code, loaded for
-the first render, serves the next ones at once. A scene that fails to load or render
-prints its one-line error and the watch goes on; Ctrl-C ends it (cli.py).
+the first render, serves the next ones at once, and a mesh whose file did not change
+is reused as built, without reading its file or building its BVH again
+(scenefile/reuse.py). A scene that fails to load or render prints its one-line error
+and the watch goes on; Ctrl-C ends it (cli.py).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from collections.abc import Callable
 
 from rtcli.errors import RtcliError, one_line
 from rtcli.scenefile.files import recording_stamps, stamp
+from rtcli.scenefile.reuse import Kept, reusing
 
 POLL = 0.25                        # seconds between looks at the files
 
@@ -27,9 +30,9 @@ POLL = 0.25                        # seconds between looks at the files
 def watch(scene: str, render: Callable[[], None], error: Callable[[str], None], poll: float = POLL) -> None:
     """Call render() (which loads `scene`, renders and writes it) now and after every change of
     the files it read; a failure goes to error() as its one line. Runs until interrupted."""
-    path = os.path.realpath(scene)
+    path, kept = os.path.realpath(scene), Kept()
     while True:
-        with recording_stamps() as seen:
+        with recording_stamps() as seen, reusing(kept):
             try:
                 render()
             except (RtcliError, MemoryError) as e:

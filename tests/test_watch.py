@@ -20,8 +20,10 @@ from click.testing import CliRunner
 from PIL import Image
 
 from rtcli import api
+from rtcli.errors import SceneError
 from rtcli import watch as watching
 from rtcli.cli import main
+from rtcli.scenefile.reuse import Kept, reusing
 from rtcli.watch import watch
 
 SCENE = """\
@@ -152,3 +154,84 @@ def test_watch_takes_one_scene(tmp_path, monkeypatch):
         (tmp_path / name).write_text(SCENE % 1)
     result = CliRunner().invoke(main, ["render", "a.yaml", "b.yaml", "--watch"])
     assert (result.exit_code, result.output) == (2, "error: --watch renders one scene file\n")
+
+
+# --- meshes kept from one load to the next ---
+MESH_SCENE = """\
+camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}
+objects:
+  - {mesh: {file: m.obj, smooth: %s}}
+  - {mesh: {file: m.obj, smooth: true}}
+"""
+OCTAHEDRON = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\n"
+
+
+def meshes(path, kept: Kept | None) -> list:
+    """The shapes of the scene at `path`, loaded within reusing(kept) (or outside any watch)."""
+    if kept is None:
+        scene = api.load_scene(str(path))
+    else:
+        with reusing(kept):
+            scene = api.load_scene(str(path))
+    assert os.path.realpath(path.parent / "m.obj") in scene.inputs          # an input, reused or not
+    return [o.shape for o in scene.model.objects]
+
+
+def test_an_unchanged_mesh_is_reused_and_a_changed_one_read_again(tmp_path):
+    (tmp_path / "m.obj").write_text(OCTAHEDRON)
+    (tmp_path / "s.yaml").write_text(MESH_SCENE % "false")
+    path, kept = tmp_path / "s.yaml", Kept()
+    first = meshes(path, kept)
+    assert first[0] is not first[1] and first[0].smooth is False          # other parameters: another mesh
+    again = meshes(path, kept)
+    assert again[0] is first[0] and again[1] is first[1]
+    (tmp_path / "s.yaml").write_text(MESH_SCENE % "true")
+    both_smooth = meshes(path, kept)
+    assert both_smooth[0] is both_smooth[1] is first[1]
+    (tmp_path / "m.obj").write_text(OCTAHEDRON + "f 1 6 3\n")                # the file changes
+    changed = meshes(path, kept)
+    assert changed[0] is not first[1] and len(changed[0]) == 5
+    assert len(kept.previous) == 2                                          # the file's data and one mesh
+    assert meshes(path, None)[0] is not meshes(path, None)[0]               # outside a watch: built each time
+
+
+def test_a_reused_mesh_file_is_still_checked(tmp_path):
+    (tmp_path / "m.obj").write_text(OCTAHEDRON)
+    (tmp_path / "s.yaml").write_text(MESH_SCENE % "true")
+    kept = Kept()
+    meshes(tmp_path / "s.yaml", kept)
+    (tmp_path / "m.obj").unlink()
+    with pytest.raises(SceneError, match=r"s\.yaml:3:.*objects\[0\]\.mesh\.file: file not found"):
+        meshes(tmp_path / "s.yaml", kept)
+
+
+def test_meshes_are_kept_across_a_broken_edit(tmp_path):
+    """A load that fails before reaching a mesh does not make the next one build it again."""
+    (tmp_path / "m.obj").write_text(OCTAHEDRON)
+    (tmp_path / "s.yaml").write_text(MESH_SCENE % "true")
+    kept = Kept()
+    first = meshes(tmp_path / "s.yaml", kept)
+    (tmp_path / "s.yaml").write_text("include: [missing.yaml]\n" + MESH_SCENE % "true")
+    with pytest.raises(SceneError, match="file not found"):
+        meshes(tmp_path / "s.yaml", kept)
+    (tmp_path / "s.yaml").write_text(MESH_SCENE % "true")
+    assert meshes(tmp_path / "s.yaml", kept)[0] is first[0]
+
+
+def test_the_watch_reuses_a_mesh_whose_file_did_not_change(tmp_path, patience):
+    (tmp_path / "m.obj").write_text(OCTAHEDRON)
+    (tmp_path / "s.yaml").write_text(MESH_SCENE % "true")
+    loaded = []
+
+    def render():
+        loaded.append(api.load_scene(str(tmp_path / "s.yaml")).model.objects)
+        if len(loaded) == 3:
+            raise KeyboardInterrupt
+        if len(loaded) == 1:
+            (tmp_path / "s.yaml").write_text(MESH_SCENE % "true" + "# an edit of the scene alone\n")
+        else:
+            (tmp_path / "m.obj").write_text(OCTAHEDRON + "f 1 6 3\n")
+    with pytest.raises(KeyboardInterrupt):
+        watch(str(tmp_path / "s.yaml"), render, pytest.fail, poll=0.02)
+    first, second, third = ([o.shape for o in objects] for objects in loaded)
+    assert second[0] is first[0] and third[0] is not first[0] and len(third[0]) == 5

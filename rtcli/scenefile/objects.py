@@ -20,8 +20,10 @@ from rtcli.core.scene import SceneObject
 from rtcli.core.textures import Checker, ImageTexture
 from rtcli.errors import SceneError, quoted, shown
 from rtcli.scenefile import params as required
+from rtcli.scenefile import reuse
 from rtcli.scenefile.files import open_image
 from rtcli.scenefile.guards import bounded, check_count, scale_factors
+from rtcli.scenefile.limits import MAX_MESH_BYTES
 from rtcli.scenefile.obj import read_obj
 from rtcli.scenefile.params import MATERIAL_KEYS, Params, as_params, describe
 from rtcli.scenefile.presets import PRESETS
@@ -219,7 +221,7 @@ def shape_from(p: Params, cls):
         else:
             raise TypeError(f"unknown parameter kind {param.kind!r}")
     try:
-        return cls.from_values(**values)
+        return reuse.shape(cls, values, files, lambda: cls.from_values(**values))     # a watch's unchanged mesh
     except ParamError as e:
         key = next((k for k in e.keys if p.has(k)), e.keys[-1])
         raise p.error(key, f"{e}: {shown(files[key])}" if key in files else str(e)) from None
@@ -227,7 +229,7 @@ def shape_from(p: Params, cls):
 
 def _read_mesh_file(p: Params, key: str, path: str):
     try:
-        return read_obj(path)
+        return reuse.file_data(path, MAX_MESH_BYTES, lambda: read_obj(path))
     except FileNotFoundError:
         raise p.error(key, f"file not found: {shown(path)}") from None
     except OSError as e:
