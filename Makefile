@@ -26,7 +26,9 @@ golden: $(STAMP)
 	$(PY) -m pytest -q tests/test_golden.py --update-goldens
 
 bench: $(STAMP)
+	-$(PY) -m pip install --quiet -e '.[bench]' || echo "the bench extra (mitsuba, embreex) did not install: timing without them"
 	$(PY) bench/run.py
+	$(PY) bench/rays.py
 
 clean:
 	rm -rf $(VENV) *.egg-info whitted.png

@@ -1,14 +1,17 @@
-"""rtcli against POV-Ray 3.7 on the reference scenes, side by side in one run.
+"""rtcli against POV-Ray 3.7 and Mitsuba 3 on the reference scenes, side by side in one run.
 
-For each scene and size, rtcli and POV-Ray (when `povray` is on PATH) render
-alternately, `--runs` times each, every run a whole process timed by wall clock
-as a user sees it. The table gives the medians, their ratio (rtcli / POV-Ray;
-below 1 means rtcli is faster) and rtcli's rays per second. Each rtcli image is
+For each scene and size, rtcli, POV-Ray (when `povray` is on PATH) and Mitsuba 3
+(when a Python with mitsuba is found: variants llvm_ad_rgb and scalar_rgb, the
+scenes of bench/mitsuba_scenes.py) render in turn, `--runs` times each, every run a
+whole process timed by wall clock as a user sees it. The table gives the medians,
+rtcli's ratio to each (rtcli / peer; below 1 means rtcli is faster) and rtcli's rays
+per second. Each rtcli image is
 then checked against POV-Ray's with a loose gate, and the share of pixels that
 differ by more than 10% in some channel is reported: the pictures should show
 the same objects, lights and shadows.
 
     python bench/run.py [--runs 3] [--sizes 640x480,1920x1080] [--scenes whitted,quadrics] [--engine auto]
+                        [--mitsuba-python PATH] [--mitsuba-variants llvm_ad_rgb,scalar_rgb]
 
 The engine column says which engine rtcli used (`--engine auto` picks numpy for
 the small size and the compiled integrator for the large one).
@@ -80,23 +83,40 @@ def framed_like_povray(scene: str, w: int, h: int) -> str:
     return name
 
 
-def bench(scene, w, h, runs, workers, engine, tmp, pov):
+def mitsuba_cmd(python, scene, variant, out, w, h):
+    return [python, os.path.join(HERE, "mitsuba_scenes.py"), scene, variant, str(w), str(h), out]
+
+
+def has_mitsuba(python: str) -> bool:
+    return subprocess.run([python, "-c", "import mitsuba"], capture_output=True).returncode == 0
+
+
+def bench(scene, w, h, runs, workers, engine, tmp, pov, mitsuba):
+    """Median whole-process seconds of rtcli and each peer, run in turn `runs` times; rtcli's rays
+    per second, the engine it used, and the share of pixels differing from POV-Ray's image."""
+    from mitsuba_scenes import SCENES as MITSUBA_SCENES
     rt_scene = framed_like_povray(scene, w, h)
-    rt_out, pov_out = os.path.join(tmp, f"{scene}_{w}x{h}_rt.png"), os.path.join(tmp, f"{scene}_{w}x{h}_pov.png")
-    rt_times, pov_times, rays = [], [], 0
+    out = lambda who: os.path.join(tmp, f"{scene}_{w}x{h}_{who}.png")        # noqa: E731
+    programs = {"rtcli": None}
+    if pov:
+        programs["POV-Ray"] = povray_cmd(scene, out("pov"), w, h, workers)
+    for variant in mitsuba["variants"] if mitsuba and scene in MITSUBA_SCENES else ():
+        programs[variant] = mitsuba_cmd(mitsuba["python"], scene, variant, out(variant), w, h)
+    times, rays, used = {name: [] for name in programs}, 0, "?"
     for _ in range(runs):
-        seconds, stdout = timed(rtcli_cmd(rt_scene, rt_out, w, h, workers, engine), HERE)
-        rt_times.append(seconds)
-        rays = int(re.search(r"(\d+) total", stdout).group(1))
-        used = re.search(r"(\w+) engine", stdout).group(1)
-        if pov:
-            pov_times.append(timed(povray_cmd(scene, pov_out, w, h, workers), HERE)[0])
+        for name, cmd in programs.items():
+            if name == "rtcli":
+                seconds, stdout = timed(rtcli_cmd(rt_scene, out("rt"), w, h, workers, engine), HERE)
+                rays = int(re.search(r"(\d+) total", stdout).group(1))
+                used = re.search(r"(\w+) engine", stdout).group(1)
+            else:
+                seconds = timed(cmd, HERE)[0]
+            times[name].append(seconds)
     if rt_scene != scene:
         os.remove(os.path.join(HERE, f"{rt_scene}.yaml"))
-    rt = statistics.median(rt_times)
-    pv = statistics.median(pov_times) if pov else float("nan")
-    share = differing_share(rt_out, pov_out) if pov else float("nan")
-    return rt, pv, rays / rt, share, used
+    medians = {name: statistics.median(t) for name, t in times.items()}
+    share = differing_share(out("rt"), out("pov")) if pov else float("nan")
+    return medians, rays / medians["rtcli"], share, used
 
 
 def main():
@@ -106,22 +126,35 @@ def main():
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--engine", default="auto", choices=["auto", "numpy", "compiled"])
+    ap.add_argument("--mitsuba-python", default=sys.executable,
+                    help="a Python that imports mitsuba (default: this one; the 'bench' extra installs it)")
+    ap.add_argument("--mitsuba-variants", default="llvm_ad_rgb,scalar_rgb")
     ap.add_argument("--keep", help="folder to keep the rendered images in")
     args = ap.parse_args()
+    sys.path.insert(0, HERE)
     pov = shutil.which("povray") is not None
     if not pov:
-        print("povray not found (apt-get install povray): timing rtcli alone")
+        print("povray not found (apt-get install povray): no POV-Ray column")
+    mitsuba = None
+    if has_mitsuba(args.mitsuba_python):
+        mitsuba = {"python": args.mitsuba_python, "variants": args.mitsuba_variants.split(",")}
+    else:
+        print("mitsuba not found (pip install -e '.[bench]', or --mitsuba-python): no Mitsuba columns")
     tmp = args.keep or tempfile.mkdtemp(prefix="rtcli-bench-")
     os.makedirs(tmp, exist_ok=True)
-    print(f"{'scene':<10} {'size':>9} {'engine':>8} {'rtcli s':>8} {'POV-Ray s':>9} {'ratio':>6} "
-          f"{'rtcli rays/s':>13} {'differ':>7}")
+    peers = (["POV-Ray"] if pov else []) + (mitsuba["variants"] if mitsuba else [])
+    print(f"{'scene':<10} {'size':>9} {'engine':>8} {'rtcli s':>8} "
+          + "".join(f"{p + ' s':>15} {'ratio':>6} " for p in peers) + f"{'rtcli rays/s':>13} {'differ':>7}")
     for scene in args.scenes.split(","):
         for size in args.sizes.split(","):
             w, h = (int(x) for x in size.split("x"))
-            rt, pv, rate, share, used = bench(scene, w, h, args.runs, args.workers, args.engine, tmp, pov)
-            print(f"{scene:<10} {size:>9} {used:>8} {rt:8.2f} {pv:9.2f} {rt / pv:6.2f} {rate:13,.0f} {share:7.1%}",
-                  flush=True)
-    print(f"images in {tmp}")
+            medians, rate, share, used = bench(scene, w, h, args.runs, args.workers, args.engine, tmp, pov, mitsuba)
+            rt = medians["rtcli"]
+            cells = "".join(f"{medians[p]:15.2f} {rt / medians[p]:6.2f} " if p in medians else f"{'-':>15} {'-':>6} "
+                            for p in peers)
+            print(f"{scene:<10} {size:>9} {used:>8} {rt:8.2f} {cells}{rate:13,.0f} {share:7.1%}", flush=True)
+    print(f"ratio: rtcli / peer, below 1 when rtcli is faster. Mitsuba does the same work on "
+          f"spheres1k and torus100k, similar work on whitted (a path tracer), none on quadrics. Images in {tmp}")
 
 
 if __name__ == "__main__":

@@ -31,11 +31,12 @@ class Item:
     output: str                       # the image it renders to
 
 
-def plan(args: list[str], output: str | None) -> tuple[list[Item], str | None]:
-    """The (scene, output) pairs, and the folder -o names when it names one (else None)."""
+def plan(args: list[str], output: str | None, suffix: str = ".png") -> tuple[list[Item], str | None]:
+    """The (scene, output) pairs, and the folder -o names when it names one (else None); an output
+    not named is the scene's name + suffix."""
     scenes = [s for arg in args for s in _scenes_of(arg)]
     if len(args) == 1 and scenes == [args[0]]:
-        return [Item(args[0], output or _stem(args[0]) + ".png")], None
+        return [Item(args[0], output or _stem(args[0]) + suffix)], None
     folder = output or "."
     if os.path.splitext(folder)[1].lower() in FORMATS and not os.path.isdir(folder):
         raise RtcliError(f"{shown(folder)}: with several scenes, -o names a folder for their images")
@@ -43,7 +44,7 @@ def plan(args: list[str], output: str | None) -> tuple[list[Item], str | None]:
         raise RtcliError(f"{shown(folder)}: with several scenes, -o names a folder, but this is a file")
     items, by_output = [], {}
     for scene in scenes:
-        out = os.path.join(output, _stem(scene) + ".png") if output else _stem(scene) + ".png"
+        out = os.path.join(output, _stem(scene) + suffix) if output else _stem(scene) + suffix
         if out in by_output:
             raise RtcliError(f"{shown(by_output[out])} and {shown(scene)} would both render to {shown(out)}")
         by_output[out] = scene

@@ -1,4 +1,4 @@
-"""The rtcli command line (README.md, Commands): render, signature, compare, validate, presets.
+"""The rtcli command line (README.md, Commands): render, signature, explain, compare, validate, presets.
 
 Argument handling only. Errors from the library (RtcliError) and usage errors
 become one `error: ...` line on stderr with exit code 2; `--debug` shows the
@@ -20,6 +20,7 @@ from rtcli import __version__
 from rtcli.errors import Interrupted, RtcliError, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
+VIEWS = ("normal", "depth", "uv", "albedo", "bounces", "ids")          # rtcli/views.py, not imported to start
 
 
 def _on_signal(signum, frame):
@@ -137,17 +138,21 @@ def _progress(enabled: bool, label: str):
 @click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
               help="numpy core, or compiled integrator (numba); auto: compiled for big jobs it can render.")
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects: test each against every ray (for comparisons).")
+@click.option("--view", type=click.Choice(VIEWS), help="Write a debug view instead of the image (default name "
+              "NAME.VIEW.png): outward normals, depth, uv, albedo (kd T), bounces or the signature ids.")
 @click.option("--watch", is_flag=True, help="Render again whenever the scene or a file it reads changes; "
                                             "print each render's time; Ctrl-C ends.")
 def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
-           gamma, quiet, progress, stats, as_json, engine, no_bvh, watch):
+           gamma, quiet, progress, stats, as_json, engine, no_bvh, view, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format); several
     scenes, or a folder of them, to a folder of images."""
     from rtcli import api, batch
     if as_json and not stats:
         raise click.UsageError("--json goes with --stats")
+    if view and stats:
+        raise click.UsageError("--stats counts the rays of a render, not of a --view")
     api.check_engine(engine)
-    items, folder = batch.plan(list(scene_files), output)
+    items, folder = batch.plan(list(scene_files), output, f".{view}.png" if view else ".png")
     if watch and folder is not None:
         raise click.UsageError("--watch renders one scene file")
     bar = not quiet and (progress or sys.stderr.isatty())
@@ -156,6 +161,11 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
 
     def render_one(scene, label, out=None):
         api.image_size(scene.model, width, height, ("--width", "--height"))      # the options' names in errors
+        if view:
+            image = _view(scene, view, width, height, tile, label if folder is not None else None)
+            if out is not None:                                   # --watch writes each view itself
+                image.save(out)
+            return image
         return api.render(scene, width=width, height=height, engine=engine, workers=workers,
                           block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh, output=out,
                           progress=_progress(bar, one_line(label)), notes=note)
@@ -176,11 +186,20 @@ def _watch(item, load, render_one, stats: bool, as_json: bool) -> None:
         image = render_one(load(item.scene), os.path.basename(item.scene), item.output)
         seconds = time.perf_counter() - start
         click.echo(f"{time.strftime('%H:%M:%S')} rendered {shown(item.output)} "
-                   f"({image.stats.width}x{image.stats.height}) in {seconds:.2f} s")
+                   f"({image.shape[1]}x{image.shape[0]}) in {seconds:.2f} s")
         for line in batch.stats_lines([(item, image.stats, seconds)], as_json, False) if stats else ():
             click.echo(line)
     click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends")
     watch(item.scene, once, lambda line: click.echo(line, err=True))
+
+
+def _view(scene, kind: str, width, height, tile: int, label: str | None):
+    """A debug view's picture (rtcli/views.py), its summary line printed."""
+    from rtcli.results import ImageArray
+    from rtcli.views import summary, view
+    data = view(scene, kind, width=width, height=height, tile=tile)
+    click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
+    return ImageArray(data.to_8bit(), inputs=scene.inputs)
 
 
 @main.command()
@@ -211,6 +230,48 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
         click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
         for row in api.legend(scene, ids):
             click.echo(f"{row.id:>5}  {one_line(row.name) or '-':<24} {row.shape:<10} {row.pixels:>9}")
+
+
+@main.command(context_settings={"ignore_unknown_options": True})       # a negative X or Y is a pixel, not an option
+@click.argument("scene_file", metavar="SCENE.yaml")
+@click.argument("x", type=int)
+@click.argument("y", type=int)
+@click.option("--width", type=SIZE, help="Image width (the camera is kept), as given to render.")
+@click.option("--height", type=SIZE, help="Image height (the camera is kept), as given to render.")
+@click.option("--samples", type=click.IntRange(1, 16), help="N x N samples per pixel, as given to render.")
+@click.option("--max-depth", type=click.IntRange(1, 64), help="Rays per path, as given to render.")
+@click.option("--sample", "sample", type=click.IntRange(0), metavar="K",
+              help="With N x N samples: show sample K (0 to N*N-1, row by row; default 0).")
+@click.option("--all-samples", is_flag=True, help="With N x N samples: show every sample's tree.")
+@click.option("--json", "as_json", is_flag=True, help="Print the trees as JSON (every sample unless --sample).")
+@click.option("--gamma", is_flag=True, help="The 8-bit value sRGB-encoded, as render --gamma writes it.")
+@click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects, as render --no-bvh.")
+def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_samples, as_json, gamma, no_bvh):
+    """Explain why pixel (X, Y) has its color: its ray tree, every term of the shading equation
+    with its numbers, and the sum at every ray (X from the left, Y from the top, from 0)."""
+    from rtcli import api
+    from rtcli.explain import explain as explain_pixel
+    if sample is not None and all_samples:
+        raise click.UsageError("--sample and --all-samples go one at a time")
+    scene = api.load_scene(scene_file, width=width, height=height)
+    api.image_size(scene.model, width, height, ("--width", "--height"))
+    e = explain_pixel(scene, x, y, samples=samples, max_depth=max_depth, gamma=gamma, bvh=not no_bvh)
+    if sample is not None and sample >= e.samples ** 2:
+        raise click.BadParameter(f"{sample} is not a sample of this pixel: it has {e.samples ** 2} "
+                                 f"(0 to {e.samples ** 2 - 1})", param_hint="'--sample'")
+    if as_json:
+        click.echo(e.json(sample))
+        return
+    color = "NO_COLOR" not in os.environ and None                    # None: click colors only a terminal
+    click.echo(e.text(None if all_samples else sample or 0, _style), color=color)
+
+
+_STYLE_OF = {"ray": dict(fg="cyan", bold=True), "miss": dict(fg="yellow"), "sum": dict(bold=True),
+             "note": dict(dim=True), "term": {}}
+
+
+def _style(text: str, role: str) -> str:
+    return click.style(text, **_STYLE_OF[role])
 
 
 @main.command()

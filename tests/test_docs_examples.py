@@ -79,3 +79,18 @@ def test_the_ci_example_passes_then_catches_a_change(tmp_path):
     suite = next(iter(junitparser.JUnitXml.fromfile(str(tmp_path / "junit.xml"))))
     assert (suite.tests, suite.failures) == (2, 1)
     assert len((tmp_path / "renders.jsonl").read_text().splitlines()) == 2
+
+
+def test_the_debugging_guide_shows_what_explain_prints(monkeypatch):
+    """docs/debugging.md: each ```console block's command, run from the repository, prints the block."""
+    from click.testing import CliRunner
+
+    from rtcli.cli import main
+    monkeypatch.chdir(ROOT)
+    consoles = [code for kind, code in blocks("debugging.md") if kind == "console"]
+    assert len(consoles) >= 3
+    for code in consoles:
+        command, expected = code.split("\n", 1)
+        assert command.startswith("$ rtcli ")
+        result = CliRunner().invoke(main, command.split()[2:])
+        assert result.exit_code == 0 and result.output == expected, command

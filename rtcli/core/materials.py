@@ -31,6 +31,7 @@ class Material:
     shadow: bool | str = True                                           # True full, False none, "filter"
     fresnel: bool = False                                               # kr, kt scale Fresnel's R, 1 - R
     texture: object = None                                              # Checker, ImageTexture or None
+    name: str = ""                                                      # its name in `materials:`, if any
 
 
 class MaterialTable:

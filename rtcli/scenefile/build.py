@@ -6,6 +6,7 @@ Params, so unknown keys are reported with file:line:col.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import gc
 
@@ -74,7 +75,7 @@ def scene_from_docs(docs: list) -> Scene:
     for p in params:
         for name, mp in _materials(p):
             named[name] = len(table)
-            table.append(material_from(mp))
+            table.append(dataclasses.replace(material_from(mp), name=name))
     builder, lights, places = ObjectBuilder(named, table, 0), [], []
     for p in params:
         for item, where, path in p.items("lights", []):

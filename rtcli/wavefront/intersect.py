@@ -241,6 +241,18 @@ def _object_surface(scene, obj, rays, hits, rows, normal, geometric, material, t
     fill_texture(scene, p_obj, lambda sel: obj.shape.uv_at(p_obj[:, sel], prim[sel]), mat, texture, rows)
 
 
+def uv_at_hits(scene: Scene, rays: Rays, hits: Hits) -> np.ndarray:
+    """(2, n) the texture coordinates (u, v) of each hit, whether or not its material has a texture."""
+    uv = np.empty((2, len(rays)))
+    for k in np.unique(hits.obj):
+        rows = np.flatnonzero(hits.obj == k)
+        obj = scene.objects[k]
+        o_obj, d_obj = to_object(obj, rays.o[:, rows], rays.d[:, rows])
+        u, v = obj.shape.uv_at(o_obj + hits.t[rows] * d_obj, hits.prim[rows])
+        uv[:, rows] = np.broadcast_arrays(u, v, rows)[:2]
+    return uv
+
+
 def fill_texture(scene, p_obj, uv_of, mat, texture, rows) -> None:
     """Fill texture[:, rows] for the textured materials among `mat`; uv_of(selection) gives (u, v)."""
     table = scene.materials

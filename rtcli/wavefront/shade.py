@@ -22,16 +22,19 @@ from rtcli.wavefront.intersect import Surface, transmittance
 from rtcli.wavefront.rays import Rays
 
 
-def local(scene: Scene, rays: Rays, s: Surface, stats: Stats) -> np.ndarray:
-    """Emission, ambient and direct light at each surface point: colors (3, n)."""
+def local(scene: Scene, rays: Rays, s: Surface, stats: Stats, log=None) -> np.ndarray:
+    """Emission, ambient and direct light at each surface point: colors (3, n). `log`: a
+    recorder (wavefront/trace.py) shown each term."""
     m, table, T, N = s.material, scene.materials, s.texture, s.n
     color = np.array(ambient(table, m, scene.ambient, *T))
+    if log:
+        log.ambient(color)
     V = -np.array(unit(*rays.d))
     NV = dot(*N, *V)
     shiny = table.shiny[m]                               # spec is only worked out where ks > 0
     start = s.p + scene.offset * s.ng                    # feelers leave from the lit side
     blinn = scene.settings.specular == "blinn"
-    for light, row in zip(scene.lights, scene.light_rows):
+    for index, (light, row) in enumerate(zip(scene.lights, scene.light_rows)):
         I = row[COLOR:COLOR + 3]
         for cell in range(light.samples):
             q = np.array(np.broadcast_arrays(*sample_point(row, cell, *s.p), s.p[0]))[:3]
@@ -44,10 +47,15 @@ def local(scene: Scene, rays: Rays, s: Surface, stats: Stats) -> np.ndarray:
             reach = through.max(axis=0) > 0
             lit, I_lit = lit[reach], I[:, None] * through[:, reach]
             w = weight(row, r[lit], *L[:, lit], light.samples)
-            color[:, lit] += diffuse(table, m[lit], I_lit, w, NL[lit], *T[:, lit])
+            terms = diffuse(table, m[lit], I_lit, w, NL[lit], *T[:, lit])
+            color[:, lit] += terms
             spec = shiny[lit]
             hl = lit[spec]
+            cos = shine = None
             if len(hl):
                 cos = specular_cos(blinn, *N[:, hl], *L[:, hl], *V[:, hl], NL[hl], NV[hl])
-                color[:, hl] += specular(table, m[hl], I_lit[:, spec], w[spec], cos)
+                shine = np.array(specular(table, m[hl], I_lit[:, spec], w[spec], cos))
+                color[:, hl] += shine
+            if log:
+                log.light(index, cell, q, L, r, NL, start, through, lit, np.array(terms), hl, cos, shine)
     return color

@@ -8,6 +8,8 @@ wr and wt are the material's kr and kt, scaled by Fresnel's equations if it asks
 with kt moved to the mirror ray at total internal reflection if the scene asks for that
 (core/dielectric.py). Each branch recurses on the compacted subset of rays that need it. Every
 ray carries the media it is inside (Media), for Snell's n1 / n2. Colors are (3, n).
+An optional recorder (`log`, a Log) is shown every quantity as it is computed and makes a
+recorder for each subset of secondary rays; it changes nothing it sees.
 """
 
 from __future__ import annotations
@@ -41,21 +43,59 @@ class Media:
         return Media(self.ior[:, which], self.count[which])
 
 
-def trace(scene: Scene, rays: Rays, depth: int, stats: Stats, media: Media | None = None) -> np.ndarray:
+class Log:
+    """A recorder: what trace() and shade.local() show it, for the rays at hand (arrays over them).
+    This base ignores everything; rtcli/explain.py keeps every term of one ray, rtcli/views.py
+    how deep each pixel's rays go. `part` and `child` give the recorder of a subset of the rays:
+    those that hit (`seen`), and those that spawn a reflected or refracted ray (`rows`)."""
+
+    def rays(self, rays: Rays, depth: int, hits) -> None:
+        """The rays traced at this depth and their first hits."""
+
+    def surface(self, seen: np.ndarray, s) -> None:
+        """The surface (intersect.Surface) where the rays `seen` hit."""
+
+    def part(self, seen: np.ndarray) -> "Log | None":
+        return self
+
+    def ambient(self, color: np.ndarray) -> None:
+        """emission + ka Ia T at each hit."""
+
+    def light(self, index, cell, q, L, r, NL, start, through, lit, terms, hl, cos, shine) -> None:
+        """Light `index`'s sample `cell` seen from each hit (shade.local's names)."""
+
+    def glass(self, rows, n1, n2, cos_i, R, tir) -> None:
+        """Snell's indices, the cosine of incidence, Fresnel's R and total internal reflection."""
+
+    def child(self, rows: np.ndarray, kind: str, weights: np.ndarray) -> "Log | None":
+        return self
+
+    def color(self, color: np.ndarray) -> None:
+        """The color returned for each ray."""
+
+
+def trace(scene: Scene, rays: Rays, depth: int, stats: Stats, media: Media | None = None,
+          log: Log | None = None) -> np.ndarray:
     """Color seen along each ray; depth 1 is the primary ray (in the scene's medium)."""
     media = media or Media.none(scene.settings.max_depth, len(rays))
     color = np.repeat(np.asarray(scene.background, float)[:, None], len(rays), axis=1)
     hits = find_first_hit(scene, rays)
     seen = np.flatnonzero(np.isfinite(hits.t))
+    if log:
+        log.rays(rays, depth, hits)
     if len(seen):
-        color[:, seen] = shade(scene, rays[seen], surface(scene, rays[seen], hits[seen]), depth, stats,
-                               media[seen])
+        s = surface(scene, rays[seen], hits[seen])
+        if log:
+            log.surface(seen, s)
+        color[:, seen] = shade(scene, rays[seen], s, depth, stats, media[seen], log and log.part(seen))
+    if log:
+        log.color(color)
     return color
 
 
-def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats, media: Media) -> np.ndarray:
+def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats, media: Media, log: Log | None = None) -> np.ndarray:
     """rtShade: the local term plus the mirror and refracted rays (global term)."""
-    color = local(scene, rays, s, stats)
+    color = local(scene, rays, s, stats, log)
     if depth >= scene.settings.max_depth:
         return color
     table, D = scene.materials, np.array(unit(*rays.d))
@@ -70,11 +110,14 @@ def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats, media: Media) -
         R = fresnel(-dot(*D[:, glass], *s.n[:, glass]), eta)
         w_r, w_t = split(table, m, R, tir, scene.settings.total_internal_reflection == "reflect")
         wr[:, glass], wt[:, glass] = w_r, w_t
+        if log:
+            log.glass(glass, n1, n2, -dot(*D[:, glass], *s.n[:, glass]), R, tir)
     mirror = np.flatnonzero(wr.max(axis=0) > 0)
     if len(mirror):
         stats.reflected += len(mirror)
         ms = np.array(reflect(*D[:, mirror], *s.n[:, mirror]))      # ms = d - 2 (d.n) n
-        reflected = trace(scene, Rays(s.p[:, mirror] + eps[:, mirror], ms), depth + 1, stats, media[mirror])
+        reflected = trace(scene, Rays(s.p[:, mirror] + eps[:, mirror], ms), depth + 1, stats, media[mirror],
+                          log and log.child(mirror, "reflected", wr[:, mirror]))
         color[:, mirror] += wr[:, mirror] * reflected
     go = np.flatnonzero(wt[:, glass].max(axis=0) > 0) if len(glass) else glass
     if len(go):
@@ -83,5 +126,6 @@ def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats, media: Media) -
         inside, out_ior = media[rows], np.empty((len(media.ior), len(rows)))
         count = refracted_media(inside.ior, inside.count, table.ior[s.material[rows]], s.entering[rows], out_ior)
         rays_t = Rays(s.p[:, rows] - eps[:, rows], np.array(t_dir)[:, go])
-        color[:, rows] += wt[:, rows] * trace(scene, rays_t, depth + 1, stats, Media(out_ior, count))
+        color[:, rows] += wt[:, rows] * trace(scene, rays_t, depth + 1, stats, Media(out_ior, count),
+                                              log and log.child(rows, "refracted", wt[:, rows]))
     return color
