@@ -156,6 +156,21 @@ def test_watch_takes_one_scene(tmp_path, monkeypatch):
     assert (result.exit_code, result.output) == (2, "error: --watch renders one scene file\n")
 
 
+def test_watch_with_view_writes_the_view(tmp_path, monkeypatch):
+    """--watch --view KIND writes NAME.KIND.png at every change (one render here, then Ctrl-C)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.yaml").write_text(SCENE % 1)
+    (tmp_path / "mat.yaml").write_text(PAINT % "[1, 0, 0]")
+
+    def once(scene, render, error, poll=None):
+        render()
+        raise KeyboardInterrupt
+    monkeypatch.setattr(watching, "watch", once)
+    result = CliRunner().invoke(main, ["render", "s.yaml", "--watch", "--view", "normal"])
+    assert result.exit_code == 130 and " rendered s.normal.png (32x24) in " in result.output
+    assert sorted(os.listdir(tmp_path)) == ["mat.yaml", "s.normal.png", "s.yaml"]
+
+
 # --- meshes kept from one load to the next ---
 MESH_SCENE = """\
 camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}
