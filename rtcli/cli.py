@@ -185,9 +185,11 @@ def _size(model, width, height) -> tuple[int, int]:
               help="Also write the frames as an animated PNG (.apng) or GIF (.gif).")
 @click.option("--skip-existing", is_flag=True, help="Leave the frames (or images) already written; render the rest.")
 @_cluster_options
+@click.option("--watch", is_flag=True, help="Render again whenever the scene or a file it reads changes; "
+                                            "print each render's time; Ctrl-C ends.")
 def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
            gamma, quiet, progress, stats, as_json, engine, no_bvh, view, frame_range, frame, movie, skip_existing,
-           cluster, cluster_file, local_cluster):
+           cluster, cluster_file, local_cluster, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
     from rtcli import api, batch
@@ -208,6 +210,13 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
     if view and (cluster or cluster_file or local_cluster):
         raise click.UsageError("--view is computed on this machine: it takes no cluster option")
     api.check_engine(engine)
+    if watch and several:
+        raise click.UsageError("--watch renders one scene file")
+    if watch and (sequence or skip_existing):
+        raise click.UsageError("--watch renders one image at every change: give --frame N, not --frames, a "
+                               "frame pattern, a movie or --skip-existing")
+    if watch and (cluster or cluster_file or local_cluster):
+        raise click.UsageError("--watch renders on this machine: it takes no cluster option")
     where = _cluster(cluster, cluster_file, local_cluster)
     bar = not quiet and (progress or sys.stderr.isatty())
     with where or contextlib.nullcontext():
@@ -227,18 +236,23 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
             current["loaded"], scene = _load(path, frame, where is not None, samples=samples, max_depth=max_depth)
             return scene
 
-        def render_one(scene, label):
+        def render_one(scene, label, out=None):
             api.image_size(scene.model, width, height, ("--width", "--height"))      # the options' names in errors
             show = _progress(bar, one_line(label))
             if view:
-                return _view(scene, view, width, height, tile, label if folder is not None else None)
+                image = _view(scene, view, width, height, tile, label if folder is not None else None)
+                if out is not None:                               # --watch writes each view itself
+                    image.save(out)
+                return image
             if where is not None:
                 return _on_cluster(current["loaded"], scene, where, dict(samples=samples, max_depth=max_depth),
                                    width, height, block_size, tile=tile, gamma=gamma, engine=engine,
                                    bvh=not no_bvh, progress=show)
             return api.render(scene, width=width, height=height, engine=engine, workers=workers,
-                              block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh,
+                              block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh, output=out,
                               progress=show, notes=note)
+        if watch:
+            return _watch(items[0], load, render_one, stats, as_json)
         done = batch.run(items, folder, load, render_one) if items else []
     for line in batch.stats_lines(done, as_json, folder is not None) if stats else ():
         click.echo(line)
@@ -292,6 +306,23 @@ def _render_frames(scene_file: str, output, frame_range, frame, movie, skip_exis
                                "wall_seconds": round(seconds, 6)}))
     else:
         click.echo(done.line(seconds))
+
+
+def _watch(item, load, render_one, stats: bool, as_json: bool) -> None:
+    """render --watch: the scene to its image now and after every change, until Ctrl-C."""
+    from rtcli import batch
+    from rtcli.watch import watch
+
+    def once() -> None:
+        start = time.perf_counter()
+        image = render_one(load(item.scene), os.path.basename(item.scene), item.output)
+        seconds = time.perf_counter() - start
+        click.echo(f"{time.strftime('%H:%M:%S')} rendered {shown(item.output)} "
+                   f"({image.shape[1]}x{image.shape[0]}) in {seconds:.2f} s")
+        for line in batch.stats_lines([(item, image.stats, seconds)], as_json, False) if stats else ():
+            click.echo(line)
+    click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends")
+    watch(item.scene, once, lambda line: click.echo(line, err=True))
 
 
 def _view(scene, kind: str, width, height, tile: int, label: str | None):
@@ -463,12 +494,30 @@ def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
 
 @main.command()
 @click.argument("scene_file", metavar="SCENE.yaml")
-def validate(scene_file):
-    """Parse and check a scene, every frame of an animated one; print a summary. Renders nothing."""
+@click.option("--objects", "list_objects", is_flag=True,
+              help="List every object: id, name, shape, material, shadow, triangles, world-space bounds.")
+@click.option("--strict", is_flag=True, help="Warnings are errors (exit 2).")
+def validate(scene_file, list_objects, strict):
+    """Parse and check a scene, every frame of an animated one; print a summary, and warnings about
+    likely mistakes on stderr. Renders only a small signature (does the camera see anything?)."""
+    from rtcli import checks
     from rtcli.frames import load
     from rtcli.scenefile.build import summary
-    loaded = load(scene_file)
-    click.echo(f"{shown(scene_file)}: ok: {summary(loaded.scene)}{loaded.animation.check_all()}")
+    from rtcli.scenefile.remarks import recording_remarks
+    with recording_remarks() as remarks:
+        loaded = load(scene_file)
+    frames = loaded.animation.check_all()
+    scene = loaded.scene
+    found = checks.warnings(scene, remarks)
+    if strict and found:
+        more = f" (and {len(found) - 1} more warnings)" if len(found) > 1 else ""
+        raise RtcliError(f"{found[0].where}: {found[0].message}{more}")
+    click.echo(f"{shown(scene_file)}: ok: {summary(scene)}{frames}")
+    if list_objects:
+        for line in checks.object_lines(checks.object_rows(scene, remarks)):
+            click.echo(line)
+    for remark in found:
+        click.echo(one_line(str(remark)), err=True)
 
 
 @main.command()

@@ -10,17 +10,43 @@ worker outlives a parent that was killed outright.
 
 from __future__ import annotations
 
+import contextlib
 import signal
+import threading
 import time
 
 from rtcli.errors import Interrupted, RtcliError
 
 PR_SET_PDEATHSIG = 1
+HELD = {signal.SIGINT, signal.SIGTERM}          # the signals that stop a render (cli.py)
+
+
+@contextlib.contextmanager
+def held_signals():
+    """SIGINT and SIGTERM held pending while the block runs, then delivered.
+
+    Submitting tiles takes locks of the pool's queues that its manager thread also
+    takes; Ctrl-C raised inside a submit can leave one locked, and the exit, which
+    joins that thread, would then wait forever. Submitting takes milliseconds. The
+    pool's threads, started by the first submit, keep the signals held, so the main
+    thread is the one that takes them afterwards.
+    """
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def watch_worker() -> None:
-    """In a worker: ignore SIGINT (the parent handles it) and die when the parent dies."""
+    """In a worker: ignore SIGINT (the parent handles it), take SIGTERM again (it was forked while
+    the parent held it) and die when the parent dies."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)
     try:
         import ctypes
         ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)

@@ -24,7 +24,7 @@ from rtcli import compiled, wavefront
 from rtcli.core.camera import primary_ray
 from rtcli.core.jitter import hash_pixel
 from rtcli.core.scene import Scene
-from rtcli.pool import stop_pool, watch_worker, worker_died
+from rtcli.pool import held_signals, stop_pool, watch_worker, worker_died
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays
@@ -191,7 +191,8 @@ def _map_tiles(scene: Scene, engine, job: Job, tiles: list, workers: int):
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(scene, engine))
     finished = False
     try:
-        futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
+        with held_signals():                    # an interrupt inside submit() could hang the exit
+            futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
         for f in as_completed(futures):
             yield f.result()
         finished = True

@@ -193,7 +193,7 @@ HEAD = "animation: {fps: 4, frames: 8}\nobjects: [{sphere: {}}]\n"
     ("{eye: {keys: {0: [0, 0, 5]}, ease: bounce}, look_at: [0, 0, 0]}",
      "a.yaml:3:44: camera.eye.ease: must be one of linear, in, out, in_out, got 'bounce'"),
     ("{eye: {key: {0: [0, 0, 5]}}, look_at: [0, 0, 0]}",
-     "a.yaml:3:16: camera.eye.key: unknown key (did you mean 'keys'?)"),
+     "a.yaml:3:16: camera.eye.key: unknown key (did you mean 'keys'?); allowed here: keys, ease"),
     ("{eye: {keys: {}}, look_at: [0, 0, 0]}",
      "a.yaml:3:22: camera.eye.keys: needs at least one keyframe, `time: value`"),
 ])
@@ -230,7 +230,7 @@ def test_a_key_out_of_range_is_blamed_at_the_key_and_a_value_between_keys_at_its
     ("{frames: 0}", "a.yaml:1:21: animation.frames: must be in 1..100000, got 0"),
     ("{clock: [1, 1]}", "a.yaml:1:20: animation.clock: the end must come after the start, got [1, 1]"),
     ("{frames: 4, fps: -1}", "a.yaml:1:29: animation.fps: must be > 0, got -1"),
-    ("{frames: 4, rate: 2}", "a.yaml:1:24: animation.rate: unknown key (did you mean 'frames'?)"),
+    ("{frames: 4, rate: 2}", "a.yaml:1:24: animation.rate: unknown key (did you mean 'frames'?); allowed here: fps, frames"),
 ])
 def test_animation_section_errors(tmp_path, section, message):
     assert error_of(tmp_path, f"animation: {section}\ncamera: {{eye: [0, 0, 5], look_at: [0, 0, 0]}}\n") == message

@@ -51,7 +51,7 @@ def test_dict_errors_are_located_by_key_path(spec):
     assert str(e.value) == "<dict>: objects[1].sphere.radius: must be > 0, got -1"
     spec["objects"][1]["sphere"] = {"raduis": 1}
     with pytest.raises(rtcli.SceneError, match=r"^<dict>: objects\[1\]\.sphere\.raduis: unknown key "
-                                               r"\(did you mean 'radius'\?\)$"):
+                                               r"\(did you mean 'radius'\?\); allowed here: center, radius$"):
         rtcli.load_scene(spec)
 
 

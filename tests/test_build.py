@@ -34,30 +34,176 @@ def obj(shape_line: str) -> str:
     return CAM + "objects:\n  - " + shape_line + "\n"
 
 
-# --- unknown keys (with a did-you-mean hint) ---
+# --- unknown keys (with a did-you-mean hint and the keys allowed there) ---
+TOP_KEYS = "version, include, image, camera, background, ambient, render, lights, materials, objects, animation"
+CAMERA_KEYS = "eye, look_at, up, fov, focal, window, screen, transform"
+MATERIAL_KEYS = ("ambient, diffuse, specular, shininess, emission, reflection, transmission, ior, shadow, "
+                 "fresnel, texture, preset")
 UNKNOWN = {
     "top": (CAM + "objcts: []\n",
-            "scene.yaml:2:1: objcts: unknown key (did you mean 'objects'?)"),
+            f"scene.yaml:2:1: objcts: unknown key (did you mean 'objects'?); allowed here: {TOP_KEYS}"),
     #        camera: {eye: [0, 0, 5], look_at: [0, 0, 0], fovy: 30}
     #                                                     ^ 46
     "camera": ("camera: {eye: [0, 0, 5], look_at: [0, 0, 0], fovy: 30}\n",
-               "scene.yaml:1:46: camera.fovy: unknown key (did you mean 'fov'?)"),
+               f"scene.yaml:1:46: camera.fovy: unknown key (did you mean 'fov'?); allowed here: {CAMERA_KEYS}"),
     "light": (CAM + "lights:\n  - position: [1, 2, 3]\n    colour: [1, 1, 1]\n",
-              "scene.yaml:4:5: lights[0].colour: unknown key (did you mean 'color'?)"),
+              "scene.yaml:4:5: lights[0].colour: unknown key (did you mean 'color'?); "
+              "allowed here: position, color, attenuation, spot, area"),
     "material": (CAM + "materials:\n  red:\n    difuse: 0.5\n",
-                 "scene.yaml:4:5: materials.red.difuse: unknown key (did you mean 'diffuse'?)"),
+                 "scene.yaml:4:5: materials.red.difuse: unknown key (did you mean 'diffuse'?); "
+                 f"allowed here: {MATERIAL_KEYS}"),
     "object": (obj("sphere: {}\n    materail: red"),
-               "scene.yaml:4:5: objects[0].materail: unknown key (did you mean 'material'?)"),
+               "scene.yaml:4:5: objects[0].materail: unknown key (did you mean 'material'?); "
+               "allowed here: name, transform, material, sphere"),
     #            "  - sphere: {raduis: 2}": 'raduis' at 14
     "shape": (obj("sphere: {raduis: 2}"),
-              "scene.yaml:3:14: objects[0].sphere.raduis: unknown key (did you mean 'radius'?)"),
+              "scene.yaml:3:14: objects[0].sphere.raduis: unknown key (did you mean 'radius'?); "
+              "allowed here: center, radius"),
+    #            "  - square: {size: 2}": 'size' at 14
+    "shape_without_keys": (obj("square: {size: 2}"),
+                           "scene.yaml:3:14: objects[0].square.size: unknown key; no keys are allowed here"),
+    #            "    transform: [{rotation: ...": 'rotation' at 18
+    "transform_step": (obj("sphere: {}\n    transform: [{rotation: {axis: [0, 1, 0], degrees: 30}}]"),
+                       "scene.yaml:4:18: objects[0].transform[0].rotation: unknown key (did you mean 'rotate'?); "
+                       "allowed here: scale, rotate, translate, matrix"),
+    #            "  - csg: {unoin: ...": 'unoin' at 11
+    "csg_operation": (obj("csg: {unoin: [{sphere: {}}, {box: {}}]}"),
+                      "scene.yaml:3:11: objects[0].csg.unoin: unknown key (did you mean 'union'?); "
+                      "allowed here: union, intersection, difference"),
+    #            "    material: {texture: {checkr: ...": 'checkr' at 26
+    "texture_kind": (obj("sphere: {}\n    material: {texture: {checkr: {colors: [[1, 1, 1], [0, 0, 0]]}}}"),
+                     "scene.yaml:4:26: objects[0].material.texture.checkr: unknown key (did you mean 'checker'?); "
+                     "allowed here: checker, image"),
 }
 
 
 @pytest.mark.parametrize("text, expected", UNKNOWN.values(), ids=UNKNOWN.keys())
 def test_unknown_key(text, expected):
-    """An unknown key anywhere is reported at the key, with a did-you-mean hint."""
+    """An unknown key anywhere is reported at the key, with a did-you-mean hint and the keys allowed there."""
     assert error_of(text) == expected
+
+
+# --- the lecture notes' names ---
+NOTES = {
+    #            "  window: {wl: -1, ...": 'wl' at 12
+    "wl": ("camera:\n  eye: [0, 0, 5]\n  look_at: [0, 0, 0]\n  window: {wl: -1, wr: 1, wt: 1, wb: -1}\n",
+           "scene.yaml:4:12: camera.window.wl: unknown key (the notes' wl is 'left' in rtcli); "
+           "allowed here: left, right, top, bottom"),
+    "f": ("camera: {eye: [0, 0, 5], look_at: [0, 0, 0], f: 2, window: {left: -1, right: 1, top: 1, bottom: -1}}\n",
+          f"scene.yaml:1:46: camera.f: unknown key (the notes' f is 'focal' in rtcli); allowed here: {CAMERA_KEYS}"),
+    #            "camera: {position: ...": 'position' at 10, reported before the missing eye
+    "position": ("camera: {position: [0, 0, 5], look_at: [0, 0, 0]}\n",
+                 "scene.yaml:1:10: camera.position: unknown key (the notes' position is 'eye' in rtcli); "
+                 f"allowed here: {CAMERA_KEYS}"),
+    "lookat": ("camera: {eye: [0, 0, 5], lookat: [0, 0, 0]}\n",
+               "scene.yaml:1:26: camera.lookat: unknown key (the notes' lookat is 'look_at' in rtcli); "
+               f"allowed here: {CAMERA_KEYS}"),
+    #            "  red: {kd: ...": 'kd' at 9
+    "kd": (CAM + "materials:\n  red: {kd: [1, 0, 0]}\n",
+           f"scene.yaml:3:9: materials.red.kd: unknown key (the notes' kd is 'diffuse' in rtcli); "
+           f"allowed here: {MATERIAL_KEYS}"),
+    "ka": (CAM + "materials:\n  red: {ka: 0.1}\n",
+           f"scene.yaml:3:9: materials.red.ka: unknown key (the notes' ka is 'ambient' in rtcli); "
+           f"allowed here: {MATERIAL_KEYS}"),
+    "ks": (CAM + "materials:\n  red: {ks: 0.1}\n",
+           f"scene.yaml:3:9: materials.red.ks: unknown key (the notes' ks is 'specular' in rtcli); "
+           f"allowed here: {MATERIAL_KEYS}"),
+    "exponent": (CAM + "materials:\n  red: {exponent: 10}\n",
+                 f"scene.yaml:3:9: materials.red.exponent: unknown key (the notes' exponent is 'shininess' in "
+                 f"rtcli); allowed here: {MATERIAL_KEYS}"),
+    "color_in_a_material": (CAM + "materials:\n  red: {color: [1, 0, 0]}\n",
+                            f"scene.yaml:3:9: materials.red.color: unknown key (the notes' color is 'diffuse' "
+                            f"in rtcli); allowed here: {MATERIAL_KEYS}"),
+    "color_on_an_object": (obj("sphere: {}\n    color: [1, 0, 0]"),
+                           "scene.yaml:4:5: objects[0].color: unknown key (the notes' color is 'diffuse' in rtcli, "
+                           "a key of the object's material: material: {diffuse: ...}); "
+                           "allowed here: name, transform, material, sphere"),
+    "diffuse_on_an_object": (obj("sphere: {}\n    diffuse: 0.5"),
+                             "scene.yaml:4:5: objects[0].diffuse: unknown key (diffuse is a key of the object's "
+                             "material: material: {diffuse: ...}); allowed here: name, transform, material, sphere"),
+    #            "    transform: [{rotate: {axis: [0, 1, 0], angle: 30}}]": 'angle' at 44, before the missing degrees
+    "angle": (obj("sphere: {}\n    transform: [{rotate: {axis: [0, 1, 0], angle: 30}}]"),
+              "scene.yaml:4:44: objects[0].transform[0].rotate.angle: unknown key (the notes' angle is 'degrees' "
+              "in rtcli); allowed here: axis, degrees"),
+}
+
+
+@pytest.mark.parametrize("text, expected", NOTES.values(), ids=NOTES.keys())
+def test_the_notes_names_are_translated(text, expected):
+    """A key the lecture notes use (wl, f, kd, exponent, ...) is named with rtcli's word for it."""
+    assert error_of(text) == expected
+
+
+# --- a misspelt key comes before the required key it stands for ---
+MISSPELT_REQUIRED = {
+    #            "  - triangle: {vertexes: ...": 'vertexes' at 16
+    "vertexes": (obj("triangle: {vertexes: [[0, 0, 0], [1, 0, 0], [0, 1, 0]]}"),
+                 "scene.yaml:3:16: objects[0].triangle.vertexes: unknown key (did you mean 'vertices'?); "
+                 "allowed here: vertices, normals"),
+    "pos": (CAM + "lights:\n  - pos: [1, 2, 3]\n",
+            "scene.yaml:3:5: lights[0].pos: unknown key (did you mean 'position'?); "
+            "allowed here: position, color, attenuation, spot, area"),
+    "camra": ("camra: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n",
+              f"scene.yaml:1:1: camra: unknown key (did you mean 'camera'?); allowed here: {TOP_KEYS}"),
+}
+
+
+@pytest.mark.parametrize("text, expected", MISSPELT_REQUIRED.values(), ids=MISSPELT_REQUIRED.keys())
+def test_a_misspelt_key_is_reported_before_the_missing_required_key(text, expected):
+    assert error_of(text) == expected
+
+
+# --- camera forms ---
+CAMERA_FORMS = {
+    "focal_without_window": ("camera: {eye: [0, 0, 5], look_at: [0, 0, 0], focal: 2}\n",
+                             "scene.yaml:1:46: camera.focal: the fov form of the camera takes no focal "
+                             "(it takes eye, look_at, up, fov; docs/scene-format.md, Camera)"),
+    "fov_with_window": ("camera: {eye: [0, 0, 5], look_at: [0, 0, 0], fov: 30, "
+                        "window: {left: -1, right: 1, top: 1, bottom: -1}}\n",
+                        "scene.yaml:1:46: camera.fov: the window form of the camera takes no fov "
+                        "(it takes eye, look_at, up, focal, window; docs/scene-format.md, Camera)"),
+    "look_at_with_screen": ("camera: {eye: [0, 0, 5], look_at: [0, 0, 0], "
+                            "screen: {lower_left: [-2, -1, 0], horizontal: [4, 0, 0], vertical: [0, 2, 0]}}\n",
+                            "scene.yaml:1:26: camera.look_at: the screen form of the camera takes no look_at "
+                            "(it takes eye, screen; docs/scene-format.md, Camera)"),
+}
+
+
+@pytest.mark.parametrize("text, expected", CAMERA_FORMS.values(), ids=CAMERA_FORMS.keys())
+def test_a_key_of_another_camera_form_says_so(text, expected):
+    assert error_of(text) == expected
+
+
+# --- a color YAML read as a comment ---
+COMMENTED_COLORS = {
+    #            "background: #ff8000": the empty value at 12
+    "background": (CAM + "background: #ff8000\n",
+                   'scene.yaml:2:12: background: must be a color [r, g, b] or "#rrggbb", got nothing '
+                   '(YAML reads the unquoted #ff8000 as a comment: write it in quotes, "#ff8000")'),
+    "material": (CAM + "materials:\n  red:\n    diffuse: #ff0000\n",
+                 'scene.yaml:4:13: materials.red.diffuse: must be a color [r, g, b] or "#rrggbb", got nothing '
+                 '(YAML reads the unquoted #ff0000 as a comment: write it in quotes, "#ff0000")'),
+    "list_item": (CAM + "objects:\n  - sphere: {}\n    material:\n      texture:\n        checker:\n"
+                  "          colors:\n            - #ff0000\n            - #00ff00\n",
+                  "scene.yaml:8:14: objects[0].material.texture.checker.colors[0]: must be a color [r, g, b] or "
+                  '"#rrggbb", got nothing (YAML reads the unquoted #ff0000 as a comment: write it in quotes, '
+                  '"#ff0000")'),
+    "flow_list": (CAM + "objects:\n  - sphere: {}\n    material: {texture: {checker: {colors: [#ff0000, #00ff00]}}}\n",
+                  "scene.yaml:5:1: invalid YAML: did not find expected node content (YAML reads the unquoted "
+                  '#ff0000 as a comment: write it in quotes, "#ff0000")'),
+    "empty": (CAM + "background:\n",
+              'scene.yaml:2:12: background: must be a color [r, g, b] or "#rrggbb", got nothing'),
+}
+
+
+@pytest.mark.parametrize("text, expected", COMMENTED_COLORS.values(), ids=COMMENTED_COLORS.keys())
+def test_an_unquoted_hex_color_is_named(text, expected):
+    """`diffuse: #ff0000` is an empty value and a YAML comment: the message says so."""
+    assert error_of(text) == expected
+
+
+def test_a_comment_after_a_shape_key_is_still_an_empty_shape():
+    assert scene_from_yaml(obj("sphere:   # the unit sphere")).objects[0].kind == "sphere"
 
 
 # --- wrong types ---
@@ -188,10 +334,24 @@ def test_degenerate_geometry(text, expected):
 REFERENCES = {
     #          "materials:\n  m: {preset: brasss}": value at 15
     "unknown_preset": (CAM + "materials:\n  m: {preset: brasss}\n",
-                       "scene.yaml:3:15: materials.m.preset: unknown preset 'brasss' (see `rtcli presets`)"),
+                       "scene.yaml:3:15: materials.m.preset: unknown preset 'brasss' "
+                       "(did you mean 'brass'? `rtcli presets` lists them)"),
+    "unknown_preset_far_off": (CAM + "materials:\n  m: {preset: velvet}\n",
+                               "scene.yaml:3:15: materials.m.preset: unknown preset 'velvet' "
+                               "(`rtcli presets` lists them)"),
     #          "    material: nope": value at 15
     "unknown_material": (obj("sphere: {}\n    material: nope"),
-                         "scene.yaml:4:15: objects[0].material: unknown material 'nope'"),
+                         "scene.yaml:4:15: objects[0].material: unknown material 'nope' "
+                         "(the scene defines no materials)"),
+    "misspelt_material": (CAM + "materials:\n  red: {diffuse: [1, 0, 0]}\nobjects:\n"
+                          "  - sphere: {}\n    material: rde\n",
+                          "scene.yaml:6:15: objects[0].material: unknown material 'rde' (did you mean 'red'?)"),
+    "other_material": (CAM + "materials:\n  red: {diffuse: [1, 0, 0]}\n  blue: {diffuse: [0, 0, 1]}\n"
+                       "objects:\n  - sphere: {}\n    material: green\n",
+                       "scene.yaml:7:15: objects[0].material: unknown material 'green' (defined: red, blue)"),
+    "preset_as_material": (obj("sphere: {}\n    material: copper"),
+                           "scene.yaml:4:15: objects[0].material: unknown material 'copper' "
+                           "(copper is a preset: write material: {preset: copper})"),
     "two_shapes": (obj("sphere: {}\n    box: {}"),
                    "scene.yaml:4:5: objects[0].box: an object has one shape, but 'sphere' is already given"),
     "no_shape": (obj("name: x"),

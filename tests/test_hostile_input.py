@@ -244,13 +244,15 @@ def test_eye_far_away_is_refused(tmp_path):
 
 # --- messages stay on one line ---
 @pytest.mark.parametrize("text, expected", [
-    ('"fo\\no": 1\n', "scene.yaml:3:1: 'fo\\no': unknown key"),
+    ('"fo\\no": 1\n', "scene.yaml:3:1: 'fo\\no': unknown key; allowed here: version, include, image, camera, "
+                    "background, ambient, render, lights, materials, objects, animation"),
     ('objects: [{sphere: {"radiu\\ns": 1}}]\n',
-     "scene.yaml:3:21: objects[0].sphere.'radiu\\ns': unknown key (did you mean 'radius'?)"),
+     "scene.yaml:3:21: objects[0].sphere.'radiu\\ns': unknown key (did you mean 'radius'?); "
+     "allowed here: center, radius"),
     ('objects: [{sphere: {}, material: "x\\nerror: forged"}]\n',
-     "scene.yaml:3:34: objects[0].material: unknown material 'x\\nerror: forged'"),
+     "scene.yaml:3:34: objects[0].material: unknown material 'x\\nerror: forged' (the scene defines no materials)"),
     ('objects: [{sphere: {}, material: {preset: "\\e[31mred"}}]\n',
-     "scene.yaml:3:43: objects[0].material.preset: unknown preset '\\x1b[31mred' (see `rtcli presets`)"),
+     "scene.yaml:3:43: objects[0].material.preset: unknown preset '\\x1b[31mred' (`rtcli presets` lists them)"),
     ('include: ["a\\nb.yaml"]\n', "scene.yaml:3:11: include[0]: file not found: 'a\\nb.yaml'"),
     ('materials: {"m\\r\\n": {diffuse: x}}\nobjects: []\n',
      "scene.yaml:3:32: materials.'m\\r\\n'.diffuse: must be a color [r, g, b] or \"#rrggbb\", got 'x'"),

@@ -13,9 +13,15 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
+from concurrent.futures import ProcessPoolExecutor
 
 import pytest
+from helpers import scene_from_yaml
+
+from rtcli.errors import Interrupted
+from rtcli.render import Job, render
 
 pytestmark = pytest.mark.skipif(not os.path.exists("/proc/self/task"), reason="needs Linux's /proc")
 
@@ -112,3 +118,29 @@ def test_a_killed_worker_ends_the_render_with_one_line(tmp_path):
     assert returncode == 2 and seconds < 10
     assert err == "error: a worker process was killed by SIGKILL (out of memory?); the render was stopped\n"
     _nothing_left(tmp_path, proc)
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_kill"), reason="POSIX threads' signals")
+def test_ctrl_c_while_tiles_are_submitted_waits_until_every_tile_is(monkeypatch):
+    """Ctrl-C inside the pool's submit could leave a lock of its queues held and hang the exit; it
+    is held back until the tiles are all submitted, then stops the render (pool.held_signals)."""
+    scene = scene_from_yaml("camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nobjects: [{sphere: {}}]\n")
+    submitted, real_submit = [], ProcessPoolExecutor.submit
+
+    def submit(pool, *args, **kwargs):
+        submitted.append(1)
+        if len(submitted) == 3:                          # Ctrl-C arrives in the middle of submitting
+            signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
+            time.sleep(0.01)
+        return real_submit(pool, *args, **kwargs)
+
+    def interrupted(signum, frame):
+        raise Interrupted(signum)
+    monkeypatch.setattr(ProcessPoolExecutor, "submit", submit)
+    previous = signal.signal(signal.SIGINT, interrupted)
+    try:
+        with pytest.raises(Interrupted):
+            render(scene, Job(32, 32, tile=8), workers=2)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert len(submitted) == 16

@@ -25,6 +25,7 @@ class SceneObject:
     material: int                    # row of the scene's MaterialTable
     world_from_object: Transform | None = None     # None: object space is world space
     kind: str = ""                   # the YAML shape name, for legends
+    where: str = ""                  # where the scene file gives it, 'file:line:col: key.path', for messages
     transform: np.ndarray | None = field(init=False, repr=False)   # packed for the kernels (core/transform.py)
 
     def __post_init__(self):

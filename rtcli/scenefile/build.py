@@ -16,7 +16,8 @@ from rtcli.core import camera as cameras
 from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
-from rtcli.scenefile import yamlfile
+from rtcli.errors import SceneError
+from rtcli.scenefile import remarks, yamlfile
 from rtcli.scenefile.files import recording_inputs
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
 from rtcli.scenefile.objects import ObjectBuilder, material_from, transform_from
@@ -73,7 +74,8 @@ def build_scene(docs: list) -> Scene:
     """The scene of documents whose values are all plain (an animation's frame: keyframes resolved)."""
     params = [Params(doc, "") for doc in docs]
     main = params[-1]
-    main.known("animation")
+    main.known("version", "include", "image", "camera", "background", "ambient", "render",
+               "lights", "materials", "objects", "animation")
     for p in params:
         if p.has("version") and p.raw("version") != 1:
             raise p.error("version", f"unsupported version {describe(p.raw('version'))} (this is version 1)")
@@ -83,16 +85,30 @@ def build_scene(docs: list) -> Scene:
         for name, mp in _materials(p):
             named[name] = len(table)
             table.append(dataclasses.replace(material_from(mp), name=name))
-    builder, lights = ObjectBuilder(named, table, 0), []
+    builder, lights, places = ObjectBuilder(named, table, 0), [], []
     for p in params:
-        lights += [light_from(as_params(item, where, path, "a light mapping"))
-                   for item, where, path in p.items("lights", [])]
+        for item, where, path in p.items("lights", []):
+            lights.append(light_from(as_params(item, where, path, "a light mapping")))
+            places.append(remarks.at(where, path))
         builder.add_all(p.items("objects", []))
     for p in params[:-1]:
         p.check_unused()
     scene = _top_level(main, builder, lights, table)
     main.check_unused()
+    if (record := remarks.current()) is not None:
+        _remember(record, params, places)
     return scene
+
+
+def _remember(record: remarks.Remarks, params: list[Params], places: list[str]) -> None:
+    """For `rtcli validate`: where the camera, the lights and the objects are written."""
+    main = params[-1]
+    record.camera = remarks.at(main.node.value_where.get("camera", main.where), "camera")
+    record.lights = places
+    for key in ("lights", "objects"):
+        given = [p for p in params if p.has(key)]
+        place = remarks.at(given[-1].node.value_where[key] if given else main.where, key)
+        setattr(record, f"{key}_key", place)
 
 
 def _materials(p: Params):
@@ -128,17 +144,29 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
                  ambient=p.color("ambient", (0.1, 0.1, 0.1)), settings=settings, eye=eye)
 
 
+CAMERA_FORMS = {"fov": ("eye", "look_at", "up", "fov"),           # the keys of each camera form
+                "window": ("eye", "look_at", "up", "focal", "window"),
+                "screen": ("eye", "screen")}
+
+
 def camera_from(c: Params):
     """One of the three camera forms; returns (callable (nc, nr) -> Camera, eye).
 
     An optional `transform:` (the steps of an object's) moves the camera: its points
     (eye, look_at, lower_left) and directions (up, horizontal, vertical)."""
+    c.known("eye", "look_at", "up", "fov", "focal", "window", "screen", "transform")
+    form = "screen" if c.has("screen") else "window" if c.has("window") else "fov"
+    for key in c.node:
+        if key in c.read and key not in CAMERA_FORMS[form] + ("transform",):
+            raise SceneError(c.node.key_where[key], c.key_path(key), f"the {form} form of the camera takes "
+                             f"no {key} (it takes {', '.join(CAMERA_FORMS[form])}; docs/scene-format.md, Camera)")
     moved = transform_from(c)
     point = (lambda x: x) if moved is None else moved.point
     direction = (lambda x: x) if moved is None else moved.vector
     eye = point(c.vector("eye"))
-    if c.has("screen"):
+    if form == "screen":
         s = c.sub("screen")
+        s.known("lower_left", "horizontal", "vertical")
         ll, h, v = point(s.vector("lower_left")), direction(s.vector("horizontal")), direction(s.vector("vertical"))
         s.check_unused()
         if np.linalg.norm(np.cross(h, v)) == 0:
@@ -152,9 +180,10 @@ def camera_from(c: Params):
         if c.has("up"):
             raise c.error("up", "must not be parallel to the view direction (look_at - eye)")
         raise c.error(None, "the default up [0, 1, 0] is parallel to the view direction; give camera.up")
-    if c.has("window"):
+    if form == "window":
         focal = c.number("focal", 1.0, positive=True)
         w = c.sub("window")
+        w.known("left", "right", "top", "bottom")
         wl, wr, wt, wb = (w.number(k) for k in ("left", "right", "top", "bottom"))
         w.check_unused()
         if wl == wr or wt == wb:
@@ -186,6 +215,7 @@ def check_resolvable(p: Params, camera, width: int, height: int) -> None:
 
 
 def light_from(p: Params) -> PointLight:
+    p.known("position", "color", "attenuation", "spot", "area")
     position, color = p.vector("position"), p.color("color", (1.0, 1.0, 1.0))
     att = p.numbers("attenuation", 3, (1.0, 0.0, 0.0), "[c0, c1, c2]")
     if np.any(att < 0) or not np.any(att):
@@ -193,6 +223,7 @@ def light_from(p: Params) -> PointLight:
     extra = {}
     s = p.optional("spot")
     if s is not None:
+        s.known("direction", "angle", "falloff")
         direction = s.vector("direction")
         if not np.any(direction):
             raise s.error("direction", "must not be the zero vector")
@@ -205,6 +236,7 @@ def light_from(p: Params) -> PointLight:
         s.check_unused()
     a = p.optional("area")
     if a is not None:
+        a.known("u", "v", "samples")
         extra.update(area_u=a.vector("u"), area_v=a.vector("v"), area_samples=a.integer("samples", 3, 1, 16))
         a.check_unused()
     p.check_unused()

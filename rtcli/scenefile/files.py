@@ -4,7 +4,8 @@ Every input is checked with os.stat before it is opened: only regular files are
 read (opening a FIFO would block, and a device such as /dev/zero never ends), and
 files larger than their documented limit (docs/scene-format.md, "Limits") are
 refused without being read. The real paths of the files a load reads are
-recorded, so the command line can refuse an output that would overwrite one.
+recorded, so the command line can refuse an output that would overwrite one, and
+so are their stamps as read, so `rtcli render --watch` sees them change.
 
 A load can also keep the bytes of every file it reads (`collecting`), and another
 load, in another process or on another machine, can read those bytes instead of
@@ -32,6 +33,7 @@ _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
 _read: contextvars.ContextVar[list | None] = contextvars.ContextVar("rtcli_inputs", default=None)
 _kept: contextvars.ContextVar[dict | None] = contextvars.ContextVar("rtcli_kept_files", default=None)
 _served: contextvars.ContextVar[dict | None] = contextvars.ContextVar("rtcli_served_files", default=None)
+_stamps: contextvars.ContextVar[dict | None] = contextvars.ContextVar("rtcli_stamps", default=None)
 
 
 class InputError(OSError):
@@ -68,11 +70,13 @@ def check_input(path: str, limit: int) -> int:
     try:
         st = os.stat(path)
     except FileNotFoundError:
+        _stamp(path, None)
         raise
     except OSError as e:
         raise InputError(e.strerror or str(e)) from None
     if not stat.S_ISREG(st.st_mode):
         raise InputError(f"not a regular file but {kind_of(st.st_mode)}")
+    _stamp(path, st)
     if st.st_size > limit:
         raise InputError(f"too large: {st.st_size / MB:.1f} MB, more than the {limit // MB} MB allowed")
     _record(path)
@@ -142,6 +146,31 @@ def recording_inputs():
         yield read
     finally:
         _read.reset(token)
+
+
+def stamp(st: os.stat_result | None):
+    """What tells that a file changed: (size, mtime in ns, inode) of its stat, or None for no file.
+    An editor that saves by writing a new file and renaming it changes the inode."""
+    return None if st is None else (st.st_size, st.st_mtime_ns, st.st_ino)
+
+
+def _stamp(path: str, st: os.stat_result | None) -> None:
+    stamps = _stamps.get()
+    if stamps is not None:
+        stamps.setdefault(os.path.realpath(path), stamp(st))
+
+
+@contextlib.contextmanager
+def recording_stamps():
+    """Collects, in a dict by real path, the stamp of every input checked inside the block as it
+    was when checked, and None for one looked for and not found (the load then fails): what
+    `rtcli render --watch` compares to see a change, even one made while it rendered."""
+    stamps: dict = {}
+    token = _stamps.set(stamps)
+    try:
+        yield stamps
+    finally:
+        _stamps.reset(token)
 
 
 @contextlib.contextmanager

@@ -142,6 +142,19 @@ class _Items:
         return len(self.seq)
 
 
+class CommentedColor:
+    """The empty value YAML makes of `diffuse: #ff8000`: an unquoted # starts a comment.
+    It stands in the tree where None would, so that an error about it can say why."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: str):
+        self.text = text                  # the #rrggbb the comment begins with
+
+    def __repr__(self) -> str:
+        return f"CommentedColor({self.text!r})"
+
+
 def size_of(value) -> int:
     """How many values `value` stands for, counting what aliases repeat."""
     return value.size if isinstance(value, (MapNode, SeqNode)) else 1

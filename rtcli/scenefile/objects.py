@@ -8,6 +8,7 @@ the keys its class lists in `params` (rtcli/shapes/base.py), read here.
 
 from __future__ import annotations
 
+import difflib
 import os
 
 import numpy as np
@@ -19,32 +20,35 @@ from rtcli.core.scene import SceneObject
 from rtcli.core.textures import Checker, ImageTexture
 from rtcli.errors import SceneError, quoted, shown
 from rtcli.scenefile import params as required
+from rtcli.scenefile import reuse
 from rtcli.scenefile.files import open_image
 from rtcli.scenefile.guards import bounded, check_count, scale_factors
+from rtcli.scenefile.limits import MAX_MESH_BYTES
 from rtcli.scenefile.obj import read_obj
-from rtcli.scenefile.params import Params, as_params, describe
+from rtcli.scenefile.params import MATERIAL_KEYS, Params, as_params, describe
 from rtcli.scenefile.presets import PRESETS
-from rtcli.scenefile.reuse import reused
 from rtcli.scenefile.yamlfile import MapNode
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import REQUIRED, ParamError
 from rtcli.shapes.csg import CSG, OPS, Child
 
 OBJECT_KINDS = tuple(SHAPES) + ("csg", "group")
+STEPS = ("scale", "rotate", "translate", "matrix")          # the kinds of transform step
 
 
 # --- materials ---
 def material_from(p: Params) -> Material:
     """A material mapping: optional `preset:` first, then each key overrides."""
+    p.known(*MATERIAL_KEYS)                                 # allowed, in the order of the docs
     base = {}
     if p.has("preset"):
         name = p.string("preset")
         if name not in PRESETS:
-            raise p.error("preset", f"unknown preset {quoted(name)} (see `rtcli presets`)")
+            close = difflib.get_close_matches(name, list(PRESETS), n=1)
+            hint = f"did you mean {quoted(close[0])}? " if close else ""
+            raise p.error("preset", f"unknown preset {quoted(name)} ({hint}`rtcli presets` lists them)")
         pre = PRESETS[name]
         base = dict(ambient=pre.ambient, diffuse=pre.diffuse, specular=pre.specular, shininess=pre.shininess)
-    else:
-        p.known("preset")
     diffuse = p.coefficient("diffuse", base.get("diffuse", 0.8))
     texture = p.optional("texture")
     m = Material(
@@ -58,7 +62,7 @@ def material_from(p: Params) -> Material:
         ior=p.number("ior", 1.0, positive=True),
         shadow=_shadow(p),
         fresnel=p.boolean("fresnel", False),
-        texture=None if texture is None else reused(texture.node, None, lambda: texture_from(texture)),
+        texture=None if texture is None else reuse.reused(texture.node, None, lambda: texture_from(texture)),
     )
     p.check_unused()
     return m
@@ -74,10 +78,14 @@ def _shadow(p: Params):
 
 def texture_from(p: Params):
     kinds = [k for k in ("checker", "image") if p.has(k)]
+    p.known("checker", "image")
+    if not kinds:
+        p.check_unused()                                    # a misspelt kind says so
     if len(kinds) != 1:
         raise p.error(None, "a texture needs exactly one of: checker, image")
     if kinds[0] == "checker":
         c = p.sub("checker")
+        c.known("colors", "size")
         colors = c.items("colors")
         if len(colors) != 2:
             raise c.error("colors", f"must be a list of 2 colors, got {describe(c.node['colors'])}")
@@ -117,10 +125,24 @@ def material_ref(p: Params, key: str, named: dict, table: list, default: int) ->
     value = p.raw(key)
     if isinstance(value, str):
         if value not in named:
-            raise p.error(key, f"unknown material {quoted(value)}")
+            raise p.error(key, f"unknown material {quoted(value)}{_material_hint(value, named)}")
         return named[value]
     table.append(material_from(p.sub(key)))
     return len(table) - 1
+
+
+def _material_hint(name: str, named: dict) -> str:
+    """' (...)' for an unknown material name: the closest defined one, that it is a preset, or
+    which names are defined."""
+    close = difflib.get_close_matches(name, list(named), n=1)
+    if close:
+        return f" (did you mean {quoted(close[0])}?)"
+    if name in PRESETS:
+        return f" ({shown(name)} is a preset: write material: {{preset: {shown(name)}}})"
+    if not named:
+        return " (the scene defines no materials)"
+    names = [shown(n) for n in named]
+    return f" (defined: {', '.join(names[:8])}{', ...' if len(names) > 8 else ''})"
 
 
 # --- transforms ---
@@ -138,7 +160,10 @@ def transform_from(p: Params) -> tf.Transform | None:
 
 def _one_transform(p: Params) -> tf.Transform:
     keys = list(p.node)
-    if len(keys) != 1 or keys[0] not in ("scale", "rotate", "translate", "matrix"):
+    if len(keys) == 1 and keys[0] not in STEPS:
+        p.known(*STEPS)
+        p.check_unused()
+    if len(keys) != 1:
         raise p.error(None, "each transform step is one of: scale, rotate, translate, matrix")
     kind = keys[0]
     try:
@@ -150,6 +175,7 @@ def _one_transform(p: Params) -> tf.Transform:
             return tf.scale(scale_factors(p, s))
         if kind == "rotate":
             r = p.sub("rotate")
+            r.known("axis", "degrees")
             axis, degrees = r.vector("axis"), r.number("degrees")
             r.check_unused()
             if not np.any(axis):
@@ -177,6 +203,7 @@ def shape_from(p: Params, cls):
     """A shape of class `cls` from its mapping: each of cls.params read and checked, then the
     shape made from the values; its own consistency errors are located at the key they blame."""
     values, files = {}, {}
+    p.known(*(param.key for param in cls.params))
     for param in cls.params:
         default = required.REQUIRED if param.default is REQUIRED else param.default
         if param.kind == "obj":
@@ -194,7 +221,7 @@ def shape_from(p: Params, cls):
         else:
             raise TypeError(f"unknown parameter kind {param.kind!r}")
     try:
-        return cls.from_values(**values)
+        return reuse.shape(cls, values, files, lambda: cls.from_values(**values))     # a watch's unchanged mesh
     except ParamError as e:
         key = next((k for k in e.keys if p.has(k)), e.keys[-1])
         raise p.error(key, f"{e}: {shown(files[key])}" if key in files else str(e)) from None
@@ -202,7 +229,7 @@ def shape_from(p: Params, cls):
 
 def _read_mesh_file(p: Params, key: str, path: str):
     try:
-        return read_obj(path)
+        return reuse.file_data(path, MAX_MESH_BYTES, lambda: read_obj(path))
     except FileNotFoundError:
         raise p.error(key, f"file not found: {shown(path)}") from None
     except OSError as e:
@@ -211,6 +238,9 @@ def _read_mesh_file(p: Params, key: str, path: str):
 
 def csg_from(p: Params, builder: "ObjectBuilder", material: int) -> CSG:
     ops = [k for k in OPS if p.has(k)]
+    p.known(*OPS)
+    if not ops:
+        p.check_unused()                                    # a misspelt operation says so
     if len(ops) != 1:
         raise p.error(None, "a csg needs exactly one of: union, intersection, difference")
     items = p.items(ops[0])
@@ -253,14 +283,14 @@ class ObjectBuilder:
         else:
             shape = self.shape(p, kind, material)
             self.objects.append(SceneObject(len(self.objects) + 1, p.node.get("name", ""), shape,
-                                            material, world, kind))
+                                            material, world, kind, f"{p.where}: {p.path}"))
         p.check_unused()
 
     def shape(self, p: Params, kind: str, material: int):
         sp = self._shape_params(p, kind)
         if kind == "csg":                 # its children's inline materials join the table in every frame
             return self._new_shape(sp, kind, material)
-        return reused(p.node[kind] if p.node[kind] is not None else p.node, kind,
+        return reuse.reused(p.node[kind] if p.node[kind] is not None else p.node, kind,
                       lambda: self._new_shape(sp, kind, material))
 
     def _new_shape(self, sp: Params, kind: str, material: int):

@@ -2,7 +2,10 @@
 
 Every getter checks the type, reports errors as `file:line:col: key.path: message`,
 and remembers the key as read; `check_unused()` then reports the first key
-nobody read, which catches typos such as `raduis:`.
+nobody read, which catches typos such as `raduis:`. An unknown key's message
+lists the keys allowed in its mapping, suggests the closest one, and translates
+the lecture notes' names (`kd`, `wl`, `exponent`, ...) into rtcli's. A required key
+that is missing while a misspelling of it is given is reported at the misspelling.
 """
 
 from __future__ import annotations
@@ -14,9 +17,23 @@ import numpy as np
 
 from rtcli.errors import SceneError, Where, quoted, shown
 from rtcli.scenefile.limits import MAX_MAGNITUDE, RANGE
+from rtcli.scenefile.nodes import CommentedColor
+from rtcli.scenefile.remarks import note_color
 from rtcli.scenefile.yamlfile import MapNode, SeqNode
 
 REQUIRED = object()
+
+# The lecture notes' names for what rtcli calls otherwise (docs/scene-format.md, "The notes'
+# names"): a hint when one is given where rtcli's name is allowed.
+NOTES_NAMES = {
+    "wl": "left", "wr": "right", "wt": "top", "wb": "bottom",              # the window (notes 000, 11.2)
+    "f": "focal", "position": "eye", "lookat": "look_at",                   # the camera
+    "ka": "ambient", "kd": "diffuse", "ks": "specular", "kr": "reflection", "kt": "transmission",
+    "exponent": "shininess", "n": "shininess", "color": "diffuse",          # a material (notes 002, 004)
+    "angle": "degrees",                                                     # a rotate step
+}
+MATERIAL_KEYS = ("ambient", "diffuse", "specular", "shininess", "emission", "reflection", "transmission",
+                 "ior", "shadow", "fresnel", "texture", "preset")
 
 
 def _is_number(x) -> bool:
@@ -52,6 +69,9 @@ def describe(x) -> str:
         return quoted(x)
     if x is None:
         return "nothing"
+    if isinstance(x, CommentedColor):
+        return (f"nothing (YAML reads the unquoted {x.text} as a comment: write it in quotes, "
+                f"\"{x.text}\")")
     if isinstance(x, bool):
         return str(x).lower()
     if isinstance(x, int) and x.bit_length() > 64:
@@ -65,7 +85,8 @@ class Params:
     def __init__(self, node: MapNode, path: str):
         if not isinstance(node, MapNode):
             raise TypeError("Params needs a MapNode")
-        self.node, self.path, self.read = node, path, set()
+        self.node, self.path = node, path
+        self.read: dict[str, None] = {}             # the keys read or allowed, in that order
         for key, where, first in getattr(node, "duplicates", []):
             raise SceneError(where, self.key_path(key), f"duplicate key (first given at line {first.line})")
 
@@ -91,21 +112,27 @@ class Params:
         return key in self.node
 
     def known(self, *keys: str) -> None:
-        """Mark keys as read: allowed here, but read elsewhere or not at all."""
-        self.read.update(keys)
+        """Mark keys as read: allowed here, but read elsewhere or not at all. Declaring a
+        mapping's keys before reading any also keeps them from being taken for
+        misspellings of a missing required key."""
+        self.read.update(dict.fromkeys(keys))
 
     def optional(self, key: str) -> "Params | None":
         """The nested mapping at `key` as Params, or None when the key is absent."""
         if key not in self.node:
-            self.read.add(key)
+            self.read[key] = None
             return None
         return self.sub(key)
 
     def raw(self, key: str, default=REQUIRED):
-        """The value as loaded, marked read; a missing required key is an error."""
-        self.read.add(key)
+        """The value as loaded, marked read; a missing required key is an error, reported at
+        a key that looks like a misspelling of it when there is one."""
+        self.read[key] = None
         if key not in self.node:
             if default is REQUIRED:
+                for given in self.node:
+                    if given not in self.read and _misspells(given, key):
+                        raise self.unknown_key(given, key)
                 raise SceneError(self.node.where, self.key_path(key), "missing required key")
             return default
         return self.node[key]
@@ -113,9 +140,15 @@ class Params:
     def check_unused(self) -> None:
         for key in self.node:
             if key not in self.read:
-                close = difflib.get_close_matches(key, sorted(self.read), n=1)
-                hint = f" (did you mean {quoted(close[0])}?)" if close else ""
-                raise SceneError(self.node.key_where[key], self.key_path(key), f"unknown key{hint}")
+                raise self.unknown_key(key)
+
+    def unknown_key(self, key, meant: str | None = None) -> SceneError:
+        """'unknown key', with a hint (the notes' name, the key it misspells, or where it
+        belongs) and the keys allowed here."""
+        allowed = list(self.read)
+        hint = unknown_key_hint(key, allowed, meant)
+        listed = f"; allowed here: {', '.join(map(shown, allowed))}" if allowed else "; no keys are allowed here"
+        return SceneError(self.node.key_where[key], self.key_path(key), f"unknown key{hint}{listed}")
 
     # --- typed getters ---
     def number(self, key, default=REQUIRED, *, positive=False, non_negative=False) -> float:
@@ -213,6 +246,7 @@ class Params:
                 except ValueError:
                     pass
             raise SceneError(where, label, f"must be a color [r, g, b] or \"#rrggbb\", got {describe(x)}")
+        written = x
         if allow_scalar and _is_number(x):
             x = [x, x, x]
         if not isinstance(x, list) or len(x) != 3:
@@ -221,6 +255,7 @@ class Params:
             if (why := _channel_problem(v, at_most)) is not None:
                 item_where = x.item_where[k] if isinstance(x, SeqNode) else where
                 raise SceneError(item_where, f"{label}[{k}]", why)
+        note_color(written, where, label)
         return np.array(x, dtype=float)
 
     def coefficient(self, key, default=REQUIRED, at_most=None) -> np.ndarray:
@@ -248,6 +283,31 @@ class Params:
         if not isinstance(x, SeqNode):
             raise self.error(key, f"must be a list, got {describe(x)}")
         return [(v, x.item_where[k], f"{self.key_path(key)}[{k}]") for k, v in enumerate(x)]
+
+
+def _misspells(given, key: str) -> bool:
+    """Whether the key `given` looks like `key` misspelled, abbreviated or in the notes' words."""
+    if not isinstance(given, str):
+        return False
+    return (NOTES_NAMES.get(given) == key or bool(difflib.get_close_matches(key, [given], n=1))
+            or (len(given) >= 3 and key.startswith(given)))
+
+
+def unknown_key_hint(key, allowed: list, meant: str | None = None) -> str:
+    """' (...)': the lecture notes' name of an allowed key, the allowed key `key` seems to
+    misspell (`meant`, or the closest), or, for a material's key given to an object, that it
+    belongs in the material; '' when none fits."""
+    notes = NOTES_NAMES.get(key) if isinstance(key, str) else None
+    if notes in allowed:
+        return f" (the notes' {shown(key)} is {quoted(notes)} in rtcli)"
+    close = [meant] if meant else difflib.get_close_matches(str(key), allowed, n=1) or \
+        [a for a in allowed if len(str(key)) >= 3 and a.startswith(str(key))][:1]
+    if close:
+        return f" (did you mean {quoted(close[0])}?)"
+    if "material" in allowed and (notes or key) in MATERIAL_KEYS:
+        said = f"the notes' {shown(key)} is {quoted(notes)} in rtcli, a key" if notes else f"{shown(key)} is a key"
+        return f" ({said} of the object's material: material: {{{notes or key}: ...}})"
+    return ""
 
 
 def _channel_problem(v, at_most=None) -> str | None:

@@ -18,13 +18,14 @@ import yaml
 
 from rtcli.errors import SceneError, Where, quoted, shown
 from rtcli.scenefile.limits import ALIAS_BUDGET, MAX_DEPTH, RANGE
-from rtcli.scenefile.nodes import MapNode, SeqNode, pack, size_of, unpack
+from rtcli.scenefile.nodes import CommentedColor, MapNode, SeqNode, pack, size_of, unpack
 
 _TAG = "tag:yaml.org,2002:"
 _SCALAR_TAGS = {_TAG + t for t in ("null", "bool", "int", "float", "str", "binary", "timestamp")}
 _PLAIN_FLOAT = re.compile(r"-?[0-9]+\.[0-9]*\Z")      # read as a float by every YAML 1.1 rule too
 _PLAIN_INT = re.compile(r"-?[1-9][0-9]{0,17}\Z|0\Z")
 _MERGE = object()               # the value of a `<<` key
+_HEX_COMMENT = re.compile(r"[ \t]*(#[0-9a-fA-F]{6})\b")     # an unquoted color, read as a comment
 
 
 class Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):
@@ -50,8 +51,10 @@ class _Frame:
 class Builder:
     """Builds one document's MapNode/SeqNode tree from parser events, with the limits above."""
 
-    def __init__(self, loader: Loader, display: str, folder: str):
+    def __init__(self, loader: Loader, display: str, folder: str, text: str = ""):
         self.loader, self.file, self.folder = loader, display, folder
+        self.text, self.comments = text, "#" in text     # the source, for commented_color
+        self.starts: array | None = None                # where its lines start, found when first needed
         self.anchors: dict = {}            # name -> (value, where) of finished anchored values
         self.open: set = set()             # anchors of collections still being read
         self.budget = ALIAS_BUDGET
@@ -123,11 +126,28 @@ class Builder:
             value = sys.intern(text) if len(text) <= 64 else text
         elif tag == _TAG + "merge":
             value = _MERGE
+        elif tag == _TAG + "null" and not text and event.implicit[0]:
+            value = self.commented_color(event.start_mark)
         elif tag in _SCALAR_TAGS:
             value = self.construct(tag, event)
         else:
             raise SceneError(self.where(event.start_mark), "", f"invalid YAML: unsupported tag {quoted(tag)}")
         return self.anchored(event, value)
+
+    def commented_color(self, mark):
+        """None for an empty value, or a CommentedColor when an unquoted #rrggbb follows it on its
+        line (`diffuse: #ff8000`, which YAML reads as an empty value and a comment)."""
+        if not self.comments:
+            return None
+        if self.starts is None:
+            self.starts = array("Q", [0])
+            self.starts.extend(m.end() for m in re.finditer("\n", self.text))
+        if mark.line >= len(self.starts):
+            return None
+        start = self.starts[mark.line]
+        end = self.text.find("\n", start)
+        found = _HEX_COMMENT.match(self.text, start + mark.column, len(self.text) if end < 0 else end)
+        return CommentedColor(found.group(1)) if found else None
 
     def construct(self, tag: str, event):
         node = yaml.ScalarNode(tag, event.value, event.start_mark, event.end_mark, event.style)

@@ -19,6 +19,7 @@ regular files (limits.py, files.py).
 from __future__ import annotations
 
 import os
+import re
 
 import yaml
 
@@ -31,13 +32,14 @@ from rtcli.scenefile.yamlevents import Builder, Loader
 __all__ = ["MapNode", "SeqNode", "INCLUDABLE", "parse", "read_text", "load", "load_tree"]
 
 INCLUDABLE = {"version", "include", "materials", "lights", "objects"}
+_UNQUOTED_COLOR = re.compile(r"(?:^|[\s\[{,:-])(#[0-9a-fA-F]{6})\b")
 
 
 def parse(text: str, display: str, folder: str = ".") -> MapNode:
     """Parse one YAML document whose top level must be a mapping."""
     loader = Loader(text)
     try:
-        tree = Builder(loader, display, folder).document()
+        tree = Builder(loader, display, folder, text).document()
     except yaml.MarkedYAMLError as e:
         raise _syntax_error(e, text, display) from None
     except yaml.reader.ReaderError as e:
@@ -64,7 +66,19 @@ def _syntax_error(e: yaml.MarkedYAMLError, text: str, display: str) -> SceneErro
     problem = " ".join(str(e.problem or e.context).split())
     if mark and _char_at(text, mark.line, mark.column) == "\t":
         problem = "tab characters cannot indent YAML (use spaces)"
+    elif mark and (color := _commented_color(text, mark.line)):
+        problem += f" (YAML reads the unquoted {color} as a comment: write it in quotes, \"{color}\")"
     return SceneError(where, "", f"invalid YAML: {problem}")
+
+
+def _commented_color(text: str, line: int) -> str | None:
+    """The first unquoted #rrggbb on the error's line or the line before (where a flow list such
+    as `[#ff0000, #00ff00]` lost its end to the comment), or None."""
+    lines = text.splitlines()
+    for k in (line - 1, line):
+        if 0 <= k < len(lines) and (found := _UNQUOTED_COLOR.search(lines[k])):
+            return found.group(1)
+    return None
 
 
 def _character(c) -> str:

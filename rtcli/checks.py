@@ -1,0 +1,186 @@
+"""`rtcli validate`'s listing of objects and its warnings (README.md, `validate`).
+
+A warning is a likely mistake that is not an error: the scene renders, but probably
+not as meant. Each is located where the scene file gives what it is about:
+
+- a color written as 0-255 values (recorded while loading, scenefile/remarks.py);
+- no lights; no objects;
+- a camera that sees no object: no primary ray of a small image hits one;
+- a light inside a closed object that casts full shadows: it lights nothing outside;
+- an object no light reaches: at the nearest point of its box, every light's
+  attenuated intensity max(I) / (c0 + c1 r + c2 r^2) is below 1/255 (the 8-bit step),
+  or the light is a spot whose cone misses the sphere around the box.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from rtcli.core.scene import Scene
+from rtcli.errors import one_line, shown
+from rtcli.scenefile.remarks import Remark, Remarks
+
+SMALL = 64                         # the camera check's signature is SMALL pixels on its long side,
+LARGER = 512                       # then LARGER when that sees nothing (a small object can hide between rays)
+DARK = 1 / 255                     # less light than this adds less than one step to an 8-bit pixel
+LISTED = 20                        # warnings of one kind shown one by one; the rest are counted
+PROBE = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)     # a direction no box face is parallel to
+
+
+@dataclass(frozen=True)
+class ObjectRow:
+    """One line of `rtcli validate --objects`."""
+
+    id: int
+    name: str
+    shape: str
+    material: str                  # its name in `materials:`, "inline", or "default"
+    shadow: str                    # true, false or filter
+    triangles: int | None          # for meshes
+    bounds: tuple | None           # world-space (lo, hi), None when unbounded
+
+
+def object_rows(scene: Scene, remarks: Remarks) -> list[ObjectRow]:
+    """One row per object, in id order."""
+    rows = []
+    for o in scene.objects:
+        material = scene.materials.materials[o.material]
+        name = material.name or ("default" if o.material == 0 else "inline")
+        triangles = len(o.shape) if o.kind == "mesh" else None
+        rows.append(ObjectRow(o.id, o.name, o.kind, name, str(material.shadow).lower(), triangles, o.bounds()))
+    return rows
+
+
+def object_lines(rows: list[ObjectRow]) -> list[str]:
+    """The rows as aligned text: id, name, shape, material, shadow, triangles, bounds."""
+    table = [("id", "name", "shape", "material", "shadow", "triangles", "bounds")]
+    for r in rows:
+        table.append((str(r.id), one_line(r.name) or "-", r.shape, shown(r.material), r.shadow,
+                      "-" if r.triangles is None else str(r.triangles), _box(r.bounds)))
+    widths = [min(24, max(len(row[k]) for row in table)) for k in range(6)]
+    lines = []
+    for row in table:
+        cells = [row[0].rjust(widths[0])] + [c.ljust(w) for c, w in zip(row[1:5], widths[1:5])]
+        lines.append("  ".join(cells + [row[5].rjust(widths[5]), row[6]]))
+    return lines
+
+
+def _box(bounds) -> str:
+    if bounds is None:
+        return "unbounded"
+    box = np.array(bounds, dtype=float)
+    box[np.abs(box) <= 1e-12 * np.abs(box).max()] = 0.0          # rounding noise of a rotation, and -0
+    lo, hi = (", ".join(f"{v:.4g}" for v in corner) for corner in box)
+    return f"[{lo}] .. [{hi}]"
+
+
+def warnings(scene: Scene, remarks: Remarks) -> list[Remark]:
+    """Every warning about the scene, in the order of the checks above."""
+    found = list(dict.fromkeys(remarks.colors))            # a color read twice (an alias) once
+    if not scene.lights:
+        found.append(Remark(remarks.lights_key, "no lights: only ambient light and emission show "
+                                                "(a light is {position: [x, y, z]})"))
+    if not scene.objects:
+        found.append(Remark(remarks.objects_key, "no objects: the image is the background"))
+    elif not _camera_sees_something(scene):
+        found.append(Remark(remarks.camera, "the camera sees no object: every pixel of a signature render "
+                                            "is background (is look_at toward the objects?)"))
+    found += _limited(_lights_inside(scene, remarks), remarks.lights_key, "lights inside closed objects")
+    if scene.lights:
+        found += _limited(_out_of_reach(scene), remarks.objects_key, "objects that no light reaches")
+    return found
+
+
+def _limited(found: list[Remark], where: str, what: str) -> list[Remark]:
+    """The first LISTED of found, and one line counting the rest."""
+    if len(found) <= LISTED:
+        return found
+    return found[:LISTED] + [Remark(where, f"{len(found) - LISTED} more {what} (the first {LISTED} are above)")]
+
+
+# --- the camera ---
+def _camera_sees_something(scene: Scene) -> bool:
+    """Whether the primary rays through pixel centres, SMALL then LARGER pixels on the image's
+    long side, hit any object (the signature render's test, for any number of objects)."""
+    from rtcli import wavefront
+    from rtcli.render import camera_rays
+    from rtcli.wavefront.intersect import find_first_hit
+    s = scene.settings
+    wavefront.prepare(scene)
+    for size in (SMALL, LARGER):
+        scale = min(1.0, size / max(s.width, s.height))
+        w, h = max(1, round(s.width * scale)), max(1, round(s.height * scale))
+        cam = scene.camera(w, h)
+        for rows in np.array_split(np.arange(h), max(1, w * h // 16384)):         # about 16,384 rays at once
+            jj, ii = np.meshgrid(rows + 0.5, np.arange(w) + 0.5, indexing="ij")
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                hits = find_first_hit(scene, camera_rays(cam, ii.ravel(), jj.ravel(), w, h))
+            if np.isfinite(hits.t).any():
+                return True
+        if scale == 1.0:
+            break
+    return False
+
+
+# --- lights inside objects ---
+def _lights_inside(scene: Scene, remarks: Remarks) -> list[Remark]:
+    """A light inside a bounded solid (a span of the line through it holds t = 0) whose material
+    casts full shadows: its feelers to every point outside are blocked."""
+    boxes, found = scene.boxes, []
+    for k, light in enumerate(scene.lights):
+        p = light.position
+        near = np.flatnonzero(boxes.bounded & np.all(boxes.lo <= p, axis=1) & np.all(p <= boxes.hi, axis=1))
+        for i in near:
+            o = scene.objects[i]
+            if o.shape.solid and scene.materials.materials[o.material].shadow is True and _inside(o, p):
+                found.append(Remark(remarks.lights[k], f"the light is inside object {o.id} ({_named(o)}), "
+                                                       "which casts full shadows: it lights nothing outside it"))
+    return found
+
+
+def _inside(o, p: np.ndarray) -> bool:
+    t = o.world_from_object
+    origin, direction = (p, PROBE) if t is None else (t.m_inv[:3, :3] @ p + t.m_inv[:3, 3], t.m_inv[:3, :3] @ PROBE)
+    t_in, _, t_out, _ = o.shape.spans_of(origin.reshape(3, 1), direction.reshape(3, 1))
+    return bool(np.any((t_in < 0) & (t_out > 0)))
+
+
+def _named(o) -> str:
+    return f"{shown(o.name)}, a {o.kind}" if o.name else f"a {o.kind}"
+
+
+# --- objects out of every light's reach ---
+def _out_of_reach(scene: Scene) -> list[Remark]:
+    """Bounded objects without emission that no light reaches (the rule in the module docstring)."""
+    boxes, table = scene.boxes, scene.materials
+    reached = ~boxes.bounded.copy()
+    lo, hi = np.nan_to_num(boxes.lo), np.nan_to_num(boxes.hi)
+    for light in scene.lights:
+        reached |= _reaches(light, lo, hi)
+    rows = np.array([o.material for o in scene.objects], dtype=np.int64)
+    reached |= table.emission[rows].max(axis=1) > 0
+    return [Remark(scene.objects[i].where, "no light reaches it: each light's attenuated intensity at its box "
+                                           "is below 1/255, or a spot light's cone misses it")
+            for i in np.flatnonzero(~reached)]
+
+
+def _reaches(light, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Per box (N, 3 corners lo and hi): whether the light may give it 1/255 or more."""
+    p = light.position
+    spread = 0.0 if light.area_u is None else (np.linalg.norm(light.area_u) + np.linalg.norm(light.area_v)) / 2
+    r = np.maximum(np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0), axis=1) - spread, 0.0)
+    c0, c1, c2 = light.attenuation
+    with np.errstate(divide="ignore"):                 # c0 = 0 at r = 0: infinitely bright
+        bright = light.color.max() / (c0 + c1 * r + c2 * r * r) >= DARK
+    if light.spot_direction is None:
+        return bright
+    centre, radius = (lo + hi) / 2, np.linalg.norm(hi - lo, axis=1) / 2 + spread
+    v = centre - p
+    distance = np.linalg.norm(v, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        off_axis = np.arccos(np.clip(v @ light.spot_direction / distance, -1.0, 1.0))
+        seen = np.arcsin(np.clip(radius / distance, 0.0, 1.0))
+    in_cone = (distance <= radius) | (off_axis - seen <= np.arccos(light.spot_cos))
+    return bright & in_cone
