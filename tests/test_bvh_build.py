@@ -130,3 +130,17 @@ def test_a_mesh_builds_its_tree_on_first_use_and_keeps_its_bounds():
         np.testing.assert_array_equal(x, y)
     built = pickle.loads(pickle.dumps(mesh))
     assert built._bvh is not None and built._boxes is None
+
+
+def test_the_numpy_engine_builds_mesh_trees_before_its_workers_fork(yaml_scene, monkeypatch):
+    from rtcli import wavefront
+    monkeypatch.setattr(variants, "ENABLED", False)            # the numpy walk: the tree is needed in each worker
+    scene = yaml_scene(f"""
+        camera: {{eye: [0, 0, 5], look_at: [0, 0, 0]}}
+        objects:
+          - mesh: {{file: {os.path.join(HERE, "data", "polygons.obj")}}}
+        """)
+    mesh = scene.objects[0].shape
+    assert mesh._bvh is None
+    wavefront.prepare(scene)
+    assert mesh._bvh is not None
