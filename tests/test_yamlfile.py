@@ -5,6 +5,8 @@ Columns in comments are 1-based and were counted by hand.
 
 from __future__ import annotations
 
+import os
+
 import pytest
 import yaml
 from helpers import scene_from_yaml
@@ -13,6 +15,7 @@ from rtcli.errors import SceneError
 from rtcli.scenefile import yamlfile
 
 CAM = "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 LIBYAML = hasattr(yaml, "CSafeLoader")       # yamlfile uses libyaml's parser when present
 
 
@@ -167,7 +170,9 @@ SCALARS = ["1", "-1", "+1", "0", "-0", "00", "017", "0x1F", "0b101", "1_000", "1
            "123456789012345678", "1234567890123456789012", "1.5", "-1.5", "1.", ".5", "-.5", "01.50", "1e5",
            "1E-6", "-3e2", "1.5e3", "1_0.5", ".inf", "-.Inf", ".nan", "yes", "No", "on", "OFF", "true",
            "null", "~", "", "2001-12-14", "2001-12-14t21:59:43.10-05:00", "abc", "'1'", '"2.5"', "!!str 3",
-           "!!float 1", "<<x", "1.2.3"]
+           "!!float 1", "<<x", "1.2.3", "sphere", "Sphere", "n", "N", "y", "Off", "a b", "-x", "+x", "'yes'",
+           '"null"', "'1e5'", "~x", "<", "x" * 70, "'" + "y" * 70 + "'", "\"\"", "''", "!!bool true", "&a 5",
+           "\"a\\nb\"", "#x", ".x", "0.5e+2", "NULL", "Null", "nullx", "truex"]
 
 
 @pytest.mark.parametrize("scalar", SCALARS)
@@ -181,3 +186,26 @@ def test_anchors_merges_and_nesting_read_as_pyyaml_reads_them():
             "m: {<<: [*b, *o], x: 7}\nn: {<<: *o}\nl: [*b, *o, [*b]]\nk: &k 5\nj: *k\n"
             "deep: {a: {b: {c: [[[]], {}]}}}\n")
     assert yamlfile.parse(text, "s.yaml") == yaml.load(text, Loader=_PyYAML)
+
+
+@pytest.mark.parametrize("path", sorted(__import__("glob").glob(os.path.join(ROOT, "scenes", "*.yaml"))
+                                        + __import__("glob").glob(os.path.join(ROOT, "bench", "*.yaml"))),
+                         ids=os.path.basename)
+def test_scene_files_read_as_pyyaml_reads_them(path):
+    text = open(path, encoding="utf-8").read()
+    assert yamlfile.parse(text, path) == yaml.load(text, Loader=_PyYAML)
+
+
+@pytest.mark.parametrize("text, where, duplicates", [
+    ("m: {a: 1, b: [2], c: {d: 3}}\n", {"a": (5, 8), "b": (11, 14), "c": (19, 22)}, 0),
+    ("m: {a: 1, b: 2, <<: {c: 3, a: 9}, d: 4}\n", {"c": (22, 25), "a": (5, 8), "b": (11, 14), "d": (35, 38)}, 0),
+    ("m: {<<: {c: 3}, a: 1}\n", {"c": (10, 13), "a": (17, 20)}, 0),
+    ("m: {a: 1, b: 2, a: 3}\n", {"a": (17, 20), "b": (11, 14)}, 1),
+])
+def test_entries_keep_their_order_and_locations(text, where, duplicates):
+    """A mapping's keys come in PyYAML's order (merged ones first, written ones winning), and each key
+    and value keeps the column it was written at, with or without a merge key or a key given twice."""
+    m = yamlfile.parse(text, "s.yaml")["m"]
+    assert list(m) == list(where) and m == yaml.load(text, Loader=_PyYAML)["m"]
+    assert {k: (m.key_where[k].column, m.value_where[k].column) for k in m} == where
+    assert len(m.duplicates) == duplicates

@@ -8,6 +8,8 @@ which keeps the vertex order and so the outward normal. Comments (`#` to the end
 of the line) and blank lines are skipped. Everything else (g, o, s, usemtl,
 mtllib, l, p, curves, unknown statements) is ignored on purpose: the renderer
 uses geometry only. Malformed lines raise SceneError at `file:line:column`.
+Files are read by the bulk reader (obj_bulk.py, numpy over the whole file) when it
+can; parse_obj here, the careful reader, reads the rest and names every error.
 Numbers are converted in bulk by numpy; only the split into lines is a loop.
 """
 
@@ -19,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.errors import SceneError, Where, quoted
+from rtcli.scenefile import obj_bulk
 from rtcli.scenefile.files import read_bytes
 from rtcli.scenefile.limits import MAX_MESH_BYTES
 
@@ -72,7 +75,17 @@ def read_obj(path: str, display: str | None = None) -> ObjData:
 
     OBJ is ASCII; bytes that are not UTF-8 (in comments, say) are replaced, not refused.
     """
-    return parse_obj(read_bytes(path, MAX_MESH_BYTES).decode("utf-8", errors="replace"), display or path)
+    return parse_obj_bytes(read_bytes(path, MAX_MESH_BYTES), display or path)
+
+
+def parse_obj_bytes(data: bytes, display: str) -> ObjData:
+    """An OBJ file's bytes: by the bulk reader (obj_bulk.py) when it can, else by parse_obj,
+    which gives the same arrays and names any error at its line and column."""
+    bulk = obj_bulk.parse(data)
+    if bulk is None:
+        return parse_obj(data.decode("utf-8", errors="replace"), display)
+    v, vt, vn, faces, uv_faces, normal_faces = bulk
+    return ObjData(v, faces, vt, uv_faces, vn, normal_faces)
 
 
 def _statements(lines: list[str]) -> dict[str, tuple[list[int], list[list[str]]]]:

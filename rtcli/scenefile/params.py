@@ -206,6 +206,8 @@ class Params:
         return self.numbers_value(key, x, count, what)
 
     def numbers_value(self, key, x, count, what="a vector", label=None) -> np.ndarray:
+        if type(x) is SeqNode and len(x) == count and _plain_numbers(x):
+            return np.array(x, dtype=float)
         where = self.node.value_where.get(key, self.node.where)
         return finite_numbers(x, where, label or self.key_path(key), count, f"{what} of {count} numbers")
 
@@ -236,6 +238,9 @@ class Params:
         x = self.raw(key, default)
         if x is default and default is not REQUIRED:
             return np.array(x, dtype=float)
+        plain = _plain_channels(x, False, None)
+        if plain is not None:
+            return plain
         return self.color_value(key, x, self.key_path(key), self.node.value_where.get(key, self.node.where))
 
     def color_value(self, key, x, label, where, allow_scalar=False, at_most=None) -> np.ndarray:
@@ -262,7 +267,10 @@ class Params:
         """A color or one number k meaning [k, k, k]; each at most `at_most` when given."""
         x = self.raw(key, default)
         if x is default and default is not REQUIRED:
-            return np.broadcast_to(np.array(x, dtype=float), (3,)).copy()
+            return np.full(3, float(x)) if _is_number(x) else np.broadcast_to(np.array(x, dtype=float), (3,)).copy()
+        plain = _plain_channels(x, True, at_most)
+        if plain is not None:
+            return plain
         return self.color_value(key, x, self.key_path(key), self.node.value_where.get(key, self.node.where),
                                 allow_scalar=True, at_most=at_most)
 
@@ -308,6 +316,31 @@ def unknown_key_hint(key, allowed: list, meant: str | None = None) -> str:
         said = f"the notes' {shown(key)} is {quoted(notes)} in rtcli, a key" if notes else f"{shown(key)} is a key"
         return f" ({said} of the object's material: material: {{{notes or key}: ...}})"
     return ""
+
+
+def _plain_numbers(x) -> bool:
+    """Whether every item of x is an int or a float within +-MAX_MAGNITUDE (what finite_numbers
+    accepts), checked without building a label or a location."""
+    for v in x:
+        if not (type(v) is float or type(v) is int) or not -MAX_MAGNITUDE <= v <= MAX_MAGNITUDE:
+            return False
+    return True
+
+
+def _plain_channels(x, allow_scalar: bool, at_most) -> np.ndarray | None:
+    """The color of a list of three numbers (or of one number k meaning [k, k, k]) each of
+    which _channel_problem accepts, at once; None for anything else, which color_value reads
+    (and names what is wrong): the common case without building a label or a location.
+    Channels above 1 also go the careful way, which notes colors that look like 0-255 values."""
+    top = 1.0 if at_most is None else min(at_most, 1.0)
+    if allow_scalar and (type(x) is float or type(x) is int):
+        return np.full(3, float(x)) if 0 <= x <= top else None
+    if type(x) is not SeqNode or len(x) != 3:
+        return None
+    for v in x:
+        if not (type(v) is float or type(v) is int) or not 0 <= v <= top:
+            return None
+    return np.array(x, dtype=float)
 
 
 def _channel_problem(v, at_most=None) -> str | None:

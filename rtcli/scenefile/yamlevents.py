@@ -39,14 +39,21 @@ Loader.add_implicit_resolver(        # YAML 1.1 wants a dot in 1.0e-6; people wr
 )
 
 
+# First characters of plain scalars that an implicit resolver may read as something other than
+# a string (a number, a bool, null, a merge key, ...); any other plain scalar is a string.
+_RESOLVED = frozenset(Loader.yaml_implicit_resolvers) if None not in Loader.yaml_implicit_resolvers else None
+
+
 class _Frame:
-    """A mapping or list being read: the node and, for a mapping, its (key, value) events so far."""
+    """A mapping or list being read. A mapping's entries go straight into its node while
+    they are plain (no merge key, no key twice); from the first that is not, the
+    (key, value) pairs are kept instead, and fill_map orders them when it ends."""
 
     __slots__ = ("node", "anchor", "pairs", "key", "key_pos", "places", "size")
 
     def __init__(self, node, anchor, pos):
         self.node, self.anchor, self.places, self.size = node, anchor, array("Q", [pos]), 1
-        self.pairs, self.key, self.key_pos = [], None, 0
+        self.pairs, self.key, self.key_pos = None, None, 0
 
 class Builder:
     """Builds one document's MapNode/SeqNode tree from parser events, with the limits above."""
@@ -77,16 +84,45 @@ class Builder:
         return value
 
     def value(self):
-        """The next complete value, read without recursion."""
+        """The next complete value, read without recursion.
+
+        The common events are handled here, inline (a big scene is tens of thousands of
+        them): a plain or quoted scalar without tag or anchor, and the entries of lists and
+        mappings; the rest go through scalar(), alias(), add() and finish()."""
         stack: list[_Frame] = []
+        get, intern, resolved = self.loader.get_event, sys.intern, _RESOLVED
+        plain_float, plain_int = _PLAIN_FLOAT.match, _PLAIN_INT.match
         while True:
-            event = self.loader.get_event()
+            event = get()
             kind = type(event)
-            if kind is yaml.MappingStartEvent or kind is yaml.SequenceStartEvent:
-                stack.append(self.start(event, len(stack)))
-                continue
             if kind is yaml.ScalarEvent:
-                value, pos = self.scalar(event), pack(event.start_mark)
+                mark = event.start_mark
+                pos = (mark.line + 1) << 32 | (mark.column + 1)
+                if event.tag is not None or event.anchor is not None:
+                    value = self.scalar(event)
+                else:
+                    text = event.value
+                    if event.implicit[0]:                       # plain
+                        if resolved is not None and text and text[0] not in resolved:
+                            value = intern(text) if len(text) <= 64 else text
+                        elif plain_float(text):
+                            value = float(text)
+                        elif plain_int(text):
+                            value = int(text)
+                        else:
+                            value = self.scalar(event)
+                    elif event.implicit[1]:                     # quoted: a string
+                        value = intern(text) if len(text) <= 64 else text
+                    else:
+                        value = self.scalar(event)
+            elif kind is yaml.MappingStartEvent or kind is yaml.SequenceStartEvent:
+                if event.tag is None and event.anchor is None and len(stack) < MAX_DEPTH:
+                    mark = event.start_mark
+                    stack.append(_Frame(MapNode() if kind is yaml.MappingStartEvent else SeqNode(), None,
+                                        (mark.line + 1) << 32 | (mark.column + 1)))
+                else:
+                    stack.append(self.start(event, len(stack)))
+                continue
             elif kind is yaml.AliasEvent:
                 value, pos = self.alias(event), pack(event.start_mark)
             else:                                               # mapping or sequence end
@@ -94,7 +130,23 @@ class Builder:
                 pos = value.places[0]
             if not stack:
                 return value
-            self.add(stack[-1], value, pos)
+            frame = stack[-1]
+            node = frame.node
+            if type(node) is SeqNode:
+                node.append(value)
+                frame.places.append(pos)
+                frame.size += value.size if type(value) is MapNode or type(value) is SeqNode else 1
+            elif frame.key is None:
+                frame.key, frame.key_pos = (value if type(value) is str else self.key(value, pos)), pos
+            elif frame.pairs is None and frame.key is not _MERGE and frame.key not in node:
+                node[frame.key] = value
+                places = frame.places
+                places.append(frame.key_pos)
+                places.append(pos)
+                frame.size += value.size if type(value) is MapNode or type(value) is SeqNode else 1
+                frame.key = None
+            else:
+                self.add(frame, value, pos)
 
     def start(self, event, depth: int) -> _Frame:
         if depth >= MAX_DEPTH:
@@ -182,7 +234,8 @@ class Builder:
         return value
 
     def add(self, frame: _Frame, value, pos: int) -> None:
-        """Deliver a finished value, which starts at packed position `pos`, to the collection being read."""
+        """Deliver a finished value, which starts at packed position `pos`, to the collection being read
+        (value() does the common cases itself)."""
         node = frame.node
         if type(node) is SeqNode:
             node.append(value)
@@ -191,6 +244,11 @@ class Builder:
         elif frame.key is None:
             frame.key, frame.key_pos = self.key(value, pos), pos
         else:
+            if frame.pairs is None:                 # the entries so far, as pairs: fill_map orders them
+                places = frame.places
+                frame.pairs = [(key, places[1 + 2 * k], node[key], places[2 + 2 * k]) for k, key in enumerate(node)]
+                node.clear()
+                frame.places, frame.size = array("Q", places[:1]), 1
             frame.pairs.append((frame.key, frame.key_pos, value, pos))
             frame.key = None
 
@@ -206,7 +264,10 @@ class Builder:
         node.file, node.size = self.file, frame.size
         if type(node) is MapNode:
             node.folder, node._index = self.folder, None
-            self.fill_map(node, frame)
+            if frame.pairs is None:
+                node.places, node.duplicates = frame.places, ()
+            else:
+                self.fill_map(node, frame)
         else:
             node.places = frame.places
         if frame.anchor is not None:

@@ -15,7 +15,7 @@ barycentric coordinates (alpha, beta) of notes 000 11.3.1, as `triangle`.
 The faces are triangle rows of the pool (triangle.py), with the triangle's normal and
 (u, v) kernels. A mesh has no hit kernel of its own: it is hit through a BVH over its
 faces, walked with triangle_t as the leaf test (numpy's level-by-level walk here, the
-compiled per-ray walk in rtcli/core/bvh.py). A mesh has no spans: it need not be
+compiled per-ray walk in rtcli/core/bvh.py), built on first use. A mesh has no spans: it need not be
 closed, so it cannot take part in CSG.
 """
 
@@ -59,7 +59,8 @@ class Mesh(Shape):
         corner_normals = _smooth_normals(v, f[keep], cross3(b - a, c - a), normals, normal_faces, keep) \
             if smooth else None
         self.pool = triangle_rows(a, b, c, corner_normals, uvs)
-        self.bvh = BVH(np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c))
+        self._boxes = np.minimum(np.minimum(a, b), c), np.maximum(np.maximum(a, b), c)
+        self._box, self._bvh = (self._boxes[0].min(axis=0), self._boxes[1].max(axis=0)), None
         self.row = np.array([0.0, float(smooth), float(uvs is not None), 0.0])
         self.smooth = bool(smooth)
 
@@ -71,8 +72,16 @@ class Mesh(Shape):
     def __len__(self) -> int:
         return len(self.pool)
 
+    @property
+    def bvh(self) -> BVH:
+        """The BVH over the faces' boxes, built when first asked for: checking a scene needs only
+        its bounds, and a render builds it after numba has loaded (core/bvh_build.py)."""
+        if self._bvh is None:
+            self._bvh, self._boxes = BVH(*self._boxes), None
+        return self._bvh
+
     def bounds(self):
-        return self.bvh.bounds()
+        return self._box[0].copy(), self._box[1].copy()
 
     # --- the numpy walk (the compiled one: rtcli.core.bvh.walk) ---
     def hits(self, o, d, t_min, t_max):

@@ -10,19 +10,23 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli import variants
+from rtcli.shapes.mesh import Mesh
 from rtcli.wavefront.accel import Accelerator
 
 
 def prepare(scene, bvh: bool = True) -> None:
     """Ready a scene for the numpy engine: a BVH over its objects when there are enough of them
-    (unless `bvh` is False), and the compiled walks it will use loaded now, so that worker
-    processes forked later inherit them."""
+    (unless `bvh` is False), the compiled walks it will use loaded now and each mesh's BVH
+    built, so that worker processes forked later inherit them."""
     if not (bvh and scene.wants_bvh):
         scene.accel = None
     elif scene.accel is None:
         scene.accel = Accelerator(scene)
     if variants.ENABLED and uses_compiled_walks(scene):
         _warm_up(scene)
+    for o in scene.objects:                 # each mesh's tree, built once here, not in every worker
+        if isinstance(o.shape, Mesh):
+            _ = o.shape.bvh
 
 
 def uses_compiled_walks(scene) -> bool:
@@ -32,7 +36,7 @@ def uses_compiled_walks(scene) -> bool:
 
 
 def _warm_up(scene) -> None:
-    from rtcli.compiled import drop_stale_cache
+    from rtcli.compiled import drop_stale_cache, query  # noqa: F401 (numba: meshes build their trees compiled)
     from rtcli.wavefront.intersect import find_first_hit
     from rtcli.wavefront.rays import Rays
     drop_stale_cache()
