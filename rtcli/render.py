@@ -129,22 +129,25 @@ def _worker_tile(job: Job, rows, cols):
     return _run_tile(*_worker_scene, job, rows, cols)
 
 
-def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.ndarray, Stats]:
+def render(scene: Scene, job: Job, workers: int = 1, progress=None, notes=None) -> tuple[np.ndarray, Stats]:
     """The 8-bit image (H, W, 3), or the id map (H, W) uint16 for a signature, or with
     job.linear the float64 colors (H, W, 3).
 
     Each tile is converted to 8 bits where it is traced, so no float copy of the
-    whole image ever exists unless job.linear asks for one.
+    whole image ever exists unless job.linear asks for one. The stats hold apart how long the
+    compiled code took to load or compile (load_seconds, compile_seconds); `notes` is told when
+    it compiles (default: stderr).
     """
     b = job.block_size
     shape = (job.height, job.width) + (() if job.signature else (3,))
     image = np.zeros(shape, dtype=np.uint16 if job.signature else np.float64 if job.linear else np.uint8)
     stats, tiles = Stats(), list(_tiles(job, 1 if job.signature else scene.settings.samples))
     traced = sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
-    engine = None if job.signature else compiled.choose(scene, job.engine, traced, job.bvh)
-    if not engine:
-        wavefront.prepare(scene, job.bvh)
+    engine = None if job.signature else compiled.choose(scene, job.engine, traced, job.bvh, notes)
+    load = engine.load if engine else wavefront.prepare(scene, job.bvh, notes)
     stats.engine = "compiled" if engine else "numpy"            # add() keeps it
+    if load:
+        stats.load_seconds, stats.compile_seconds = load.seconds, load.compile_seconds
     with contextlib.closing(_map_tiles(scene, engine, job, tiles, workers)) as results:     # stops the pool
         for done, (rows, cols, values, s) in enumerate(results, 1):
             block = np.repeat(np.repeat(values, b, axis=0), b, axis=1)
