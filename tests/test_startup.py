@@ -144,6 +144,27 @@ def test_a_read_only_install_caches_per_user(tmp_path, monkeypatch):
         variants.cache_location.cache_clear()
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="XDG_CACHE_HOME places the per-user cache on Linux")
+def test_numba_writes_to_the_per_user_cache_when_the_sources_are_read_only(warm, tmp_path):
+    """In a process of its own, numba itself: the sources' folders refused as rtcli's check sees them."""
+    user = tmp_path / "user-cache"
+    cache = seeded(user / "rtcli" / "numba", TRACE_CAMERA)
+    code = textwrap.dedent("""
+        from rtcli import variants
+        real = variants.writable
+        variants.writable = lambda f: not f.startswith(variants.PACKAGE_DIR) and real(f)
+        from rtcli.cli import main
+        main(["warmup"])
+    """)
+    env = {k: v for k, v in os.environ.items() if k not in (variants.CACHE_ENV, "NUMBA_CACHE_DIR")}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=900,
+                          env={**env, "XDG_CACHE_HOME": str(user), "HOME": str(tmp_path)})
+    assert done.returncode == 0, done.stderr
+    assert f"cache: {cache} (the per-user cache: rtcli's folder is read-only)" in done.stdout
+    assert done.stderr.startswith(f"note: compiling the render engine, once (about a minute); cached in {cache}")
+    assert list(cache.glob(f"*/{TRACE_CAMERA}"))
+
+
 @pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0, reason="needs a user that chmod can stop")
 def test_a_read_only_copy_of_rtcli_uses_the_per_user_cache(tmp_path):
     copy = tmp_path / "site" / "rtcli"
