@@ -29,7 +29,7 @@ test-all: warmup
 golden: $(STAMP)
 	$(PY) -m pytest -q tests/test_golden.py --update-goldens
 
-bench: $(STAMP)
+bench: warmup
 	$(PY) bench/run.py
 
 clean:
