@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test test-all golden bench clean
+.PHONY: demo warmup test test-all golden bench clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -12,20 +12,24 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test,fast,flip,cluster]'
 	touch $(STAMP)
 
-demo: $(STAMP)
+# Compile the render engine once (about a minute; numba caches it), so no render waits for it.
+warmup: $(STAMP)
+	$(VENV)/bin/rtcli warmup
+
+demo: warmup
 	$(VENV)/bin/rtcli render scenes/whitted.yaml -o whitted.png --stats
 	@echo "wrote whitted.png"
 
-test: $(STAMP)
+test: warmup
 	$(PY) -m pytest -q -m "not slow"
 
-test-all: $(STAMP)
+test-all: warmup
 	$(PY) -m pytest -q
 
 golden: $(STAMP)
 	$(PY) -m pytest -q tests/test_golden.py --update-goldens
 
-bench: $(STAMP)
+bench: warmup
 	-$(PY) -m pip install --quiet -e '.[bench]' || echo "the bench extra (mitsuba, embreex) did not install: timing without them"
 	$(PY) bench/run.py
 	$(PY) bench/rays.py

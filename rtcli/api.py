@@ -66,8 +66,10 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
     default all cores; the image is the same for any count), block_size (preview), tile, gamma
     (sRGB-encode the 8-bit image), bvh. `output` also writes the image, after the same checks
     as `rtcli render -o` (made before rendering). `progress(done, total)` is called per tile;
-    `notes(text)` receives remarks such as a stretched camera (default: warnings.warn). `frame`
-    renders that frame of an animated scene (default: the Scene's own, frame 1 when loaded here).
+    `notes(text)` receives remarks: a stretched camera (default: warnings.warn), and that the
+    compiled code is being compiled, once, and how long it took (default: printed on stderr).
+    `frame` renders that frame of an animated scene (default: the Scene's own, frame 1 when
+    loaded here).
     """
     check_options(frame=frame)
     scene = _scene_of(scene, frame)
@@ -84,9 +86,9 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
     from rtcli.render import Job
     job = Job(w, h, block_size, tile=tile, gamma=gamma, engine=engine, bvh=bvh, linear=linear)
     with _settings(scene.model.settings, samples, max_depth) as s:
-        pixels, counts, seconds = _run(scene, job, workers, progress)
+        pixels, counts, seconds = _run(scene, job, workers, progress, notes)
         stats = RenderStats(w, h, s.samples, counts.engine, counts.primary, counts.shadow, counts.reflected,
-                            counts.refracted, seconds)
+                            counts.refracted, seconds, counts.load_seconds, counts.compile_seconds)
     image = ImageArray(pixels, stats, scene.inputs)
     if output is not None:
         image.save(os.fspath(output))
@@ -107,8 +109,9 @@ def signature(scene: Scene | Source, *, width: int | None = None, height: int | 
         _check_output(os.fspath(output), scene, True)
     from rtcli.render import Job
     w, h, _ = image_size(scene.model, width, height)
-    ids, counts, seconds = _run(scene, Job(w, h, block_size, signature=True), workers, None)
-    image = ImageArray(ids, RenderStats(w, h, 1, "numpy", counts.primary, 0, 0, 0, seconds), scene.inputs)
+    ids, counts, seconds = _run(scene, Job(w, h, block_size, signature=True), workers, None, None)
+    image = ImageArray(ids, RenderStats(w, h, 1, "numpy", counts.primary, 0, 0, 0, seconds, counts.load_seconds,
+                                        counts.compile_seconds), scene.inputs)
     if output is not None:
         image.save(os.fspath(output))
     return image
@@ -142,11 +145,13 @@ def _warn(note: str) -> None:
     warnings.warn(note, stacklevel=3)                 # at the caller of render()
 
 
-def _run(scene: Scene, job, workers: int | None, progress):
+def _run(scene: Scene, job, workers: int | None, progress, notes):
+    """The pixels, the counts, and the seconds of the render without the compiled code's start-up
+    (counts.load_seconds)."""
     from rtcli.render import render as render_image
     start = time.perf_counter()
-    pixels, counts = render_image(scene.model, job, workers or os.cpu_count() or 1, progress)
-    return pixels, counts, time.perf_counter() - start
+    pixels, counts = render_image(scene.model, job, workers or os.cpu_count() or 1, progress, notes)
+    return pixels, counts, time.perf_counter() - start - counts.load_seconds
 
 
 def check_engine(engine: str) -> None:

@@ -1,4 +1,4 @@
-"""The rtcli command line (README.md, Commands): render, signature, explain, compare, validate, presets.
+"""The rtcli command line (README.md, Commands): render, signature, explain, compare, validate, presets, warmup.
 
 Argument handling only. Errors from the library (RtcliError) and usage errors
 become one `error: ...` line on stderr with exit code 2; `--debug` shows the
@@ -518,6 +518,27 @@ def validate(scene_file, list_objects, strict):
             click.echo(line)
     for remark in found:
         click.echo(one_line(str(remark)), err=True)
+
+
+@main.command()
+def warmup():
+    """Compile the render engine now (about a minute, once), or load it from numba's cache; say
+    where the cache is and how long it took. Renders then start at once."""
+    import time
+
+    from rtcli import variants
+    from rtcli.compiled.warmup import warmup as warm
+    start = time.perf_counter()
+    where = variants.cache_location() if variants.ENABLED else None
+    if where is not None:
+        click.echo(f"cache: {where} ({where.why})" if where.enabled else f"cache: none ({where.why}); "
+                   f"set {variants.CACHE_ENV} to a writable folder")
+    done = warm(notes=lambda text: click.echo(f"note: {text}", err=True))
+    for what, load in done:
+        how = f"compiled in {load.compile_seconds:.1f} s" if load.compile_seconds else "loaded from the cache"
+        click.echo(f"{what}: {how}, ready in {load.seconds:.2f} s")
+    compiled = sum(load.compile_seconds for _, load in done)
+    click.echo(f"{'compiled' if compiled else 'warm: nothing to compile'}; {time.perf_counter() - start:.2f} s in all")
 
 
 @main.command()

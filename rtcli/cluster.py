@@ -241,7 +241,7 @@ def tiles_task(spec: dict, blobs: dict, frame: int, job, traced: int, tiles: lis
 
 def _prepared(spec, blobs, frame, job, traced, prepare):
     scene = _scene(spec, blobs, frame)
-    return scene, prepare(scene, job, traced)
+    return scene, prepare(scene, job, traced)[0]
 
 
 def frame_task(spec: dict, blobs: dict, frame: int, job):

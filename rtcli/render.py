@@ -129,16 +129,20 @@ def _worker_tile(job: Job, rows, cols):
     return _run_tile(*_worker_scene, job, rows, cols)
 
 
-def render(scene: Scene, job: Job, workers: int = 1, progress=None) -> tuple[np.ndarray, Stats]:
+def render(scene: Scene, job: Job, workers: int = 1, progress=None, notes=None) -> tuple[np.ndarray, Stats]:
     """The 8-bit image (H, W, 3), or the id map (H, W) uint16 for a signature, or with
     job.linear the float64 colors (H, W, 3).
 
     Each tile is converted to 8 bits where it is traced, so no float copy of the
-    whole image ever exists unless job.linear asks for one.
+    whole image ever exists unless job.linear asks for one. The stats hold apart how long the
+    compiled code took to load or compile (load_seconds, compile_seconds); `notes` is told when
+    it compiles (default: stderr).
     """
     image, (tiles, traced) = blank(job), plan(scene, job)
-    stats, engine = Stats(), prepare(scene, job, traced)
+    stats, (engine, load) = Stats(), prepare(scene, job, traced, notes)
     stats.engine = "compiled" if engine else "numpy"            # add() keeps it
+    if load:
+        stats.load_seconds, stats.compile_seconds = load.seconds, load.compile_seconds
     with contextlib.closing(_map_tiles(scene, engine, job, tiles, workers)) as results:     # stops the pool
         for done, (rows, cols, values, s) in enumerate(results, 1):
             place(image, job, rows, cols, values)
@@ -161,13 +165,14 @@ def plan(scene: Scene, job: Job) -> tuple[list, int]:
     return tiles, sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
 
 
-def prepare(scene: Scene, job: Job, traced: int):
-    """The compiled engine for the job (rtcli.compiled.choose), or None with the scene readied
-    for the numpy engine."""
-    engine = None if job.signature else compiled.choose(scene, job.engine, traced, job.bvh)
-    if not engine:
-        wavefront.prepare(scene, job.bvh)
-    return engine
+def prepare(scene: Scene, job: Job, traced: int, notes=None):
+    """(engine, load): the compiled engine for the job (rtcli.compiled.choose), or None with the
+    scene readied for the numpy engine; and how long loading compiled code took (None when
+    nothing was loaded). `notes` is told when it compiles."""
+    engine = None if job.signature else compiled.choose(scene, job.engine, traced, job.bvh, notes)
+    if engine:
+        return engine, engine.load
+    return None, wavefront.prepare(scene, job.bvh, notes)
 
 
 def run_tiles(scene: Scene, engine, job: Job, tiles: list) -> list:

@@ -31,7 +31,9 @@ class RenderStats:
     shadow: int
     reflected: int
     refracted: int
-    seconds: float                   # wall time of the render (tiles traced and assembled)
+    seconds: float                   # wall time of the render (tiles traced and assembled), start-up apart
+    load_seconds: float = 0.0        # the compiled code's start-up: numba imported, machine code loaded or compiled
+    compile_seconds: float = 0.0     # of which compiling (0 when the code came from numba's cache)
 
     @property
     def total(self) -> int:
@@ -43,15 +45,22 @@ class RenderStats:
 
     def as_dict(self) -> dict:
         """The fields, total and rays_per_second: what `rtcli render --stats --json` prints."""
-        return {**asdict(self), "seconds": round(self.seconds, 6), "total": self.total,
-                "rays_per_second": round(self.rays_per_second)}
+        return {**asdict(self), **{k: round(getattr(self, k), 6) for k in ("seconds", "load_seconds",
+                                                                           "compile_seconds")},
+                "total": self.total, "rays_per_second": round(self.rays_per_second)}
 
     def line(self, seconds: float | None = None) -> str:
-        """The one line of `rtcli render --stats` (over `seconds`, when another span is meant)."""
-        s = self.seconds if seconds is None else seconds
+        """The one line of `rtcli render --stats` (over `seconds`, when another span is meant, from
+        which the start-up is taken out), then the compiled code's start-up, when there was one."""
+        s = self.seconds if seconds is None else max(seconds - self.load_seconds, 0.0)
+        start = ""
+        if self.compile_seconds:
+            start = f"; {self.load_seconds:.2f} s more to compile the engine (once: it is cached)"
+        elif self.load_seconds:
+            start = f"; {self.load_seconds:.2f} s more to load the compiled code"
         return (f"rays: {self.primary} primary, {self.shadow} shadow, {self.reflected} reflected, "
                 f"{self.refracted} refracted, {self.total} total; {self.engine} engine; {s:.2f} s; "
-                f"{self.total / max(s, 1e-9):,.0f} rays/s")
+                f"{self.total / max(s, 1e-9):,.0f} rays/s{start}")
 
 
 class ImageArray(np.ndarray):

@@ -22,18 +22,21 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import os
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
 from rtcli import variants
+from rtcli.compiled.loading import Load, ready
 from rtcli.compiled.pack import geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
 from rtcli.stats import Stats
 
-__all__ = ["AUTO_RAYS", "Compiled", "choose", "unsupported"]
+__all__ = ["AUTO_RAYS", "Compiled", "Load", "choose", "unsupported"]
 
 
 class Compiled:
@@ -42,12 +45,13 @@ class Compiled:
     Making one compiles the integrator, or loads it from numba's cache, at once: worker
     processes forked afterwards inherit the machine code."""
 
-    def __init__(self, scene, bvh: bool = True):
+    def __init__(self, scene, bvh: bool = True, notes=None, start: float | None = None):
         self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh)
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
         nowhere, none = Camera(*np.zeros((4, 3))), np.zeros(0)
-        with _no_blas_lookup():
-            self.trace_pixels(nowhere, none, none, 1, 1, Stats())        # no ray: just the machine code
+        with _no_blas_lookup():                                        # no ray: just the machine code
+            self.load = ready([_trace_camera()], lambda: self.trace_pixels(nowhere, none, none, 1, 1, Stats()),
+                              "the render engine", "about a minute", notes, start)
 
     def trace_pixels(self, cam, x: np.ndarray, y: np.ndarray, nc: int, nr: int, stats: Stats) -> np.ndarray:
         """Colors (n, 3) of the camera's rays through pixel coordinates (x, y)."""
@@ -79,8 +83,9 @@ def _no_blas_lookup():
             del sys.modules[name]
 
 
-PACKAGE = Path(__file__).resolve().parent.parent
+PACKAGE = Path(variants.PACKAGE_DIR)
 SOURCES = ("variants.py", "core", "shapes", "compiled")     # what the machine code is made of
+STAMP = "rtcli-compiled.sha256"
 
 
 def _sources() -> list[Path]:
@@ -91,23 +96,49 @@ def _sources() -> list[Path]:
     return files
 
 
+def cache_places() -> list[tuple[list[Path], bool]]:
+    """Every place numba may keep rtcli's machine code, as (its folders, the compiled one first;
+    whether rtcli uses it now): beside the sources, RTCLI_CACHE_DIR, NUMBA_CACHE_DIR, rtcli's per-user
+    cache, and numba's own per-user cache (where numba puts it for a read-only install by itself)."""
+    dirs = [PACKAGE / "compiled", PACKAGE / "core", PACKAGE / "shapes", PACKAGE]
+    where = variants.cache_location()
+    places = [([d / "__pycache__" for d in dirs], where.enabled and where.root is None)]
+    roots = [os.environ.get(variants.CACHE_ENV), os.environ.get("NUMBA_CACHE_DIR"), variants.user_cache_dir(),
+             _numba_user_cache()]
+    for root in dict.fromkeys(os.path.abspath(os.path.expanduser(r)) for r in roots if r):
+        folders = [Path(root) / variants.numba_subfolder(str(d)) for d in dirs]
+        places.append((folders, where.enabled and where.root == root))
+    return places
+
+
+def _numba_user_cache() -> str:
+    """numba's own per-user cache folder (its appdirs' user_cache_dir for "numba")."""
+    if os.name == "nt":
+        return os.path.join(variants.user_cache_base(), "numba", "Cache")
+    return os.path.join(variants.user_cache_base(), "numba")
+
+
 def drop_stale_cache() -> None:
-    """Delete numba's cached machine code of rtcli when its sources differ from the ones it was
-    compiled from (a fingerprint kept beside it, in rtcli/compiled/__pycache__)."""
+    """Delete numba's cached machine code of rtcli, wherever it may be (cache_places), when rtcli's
+    sources differ from the ones it was compiled from (a fingerprint kept beside it,
+    rtcli-compiled.sha256 in the compiled folder's cache). numba's own check only looks at the
+    file of the function it loads, not at the files of the kernels compiled into it."""
     digest = hashlib.sha256()
     for f in _sources():
         digest.update(f.name.encode() + f.read_bytes())
-    stamp = PACKAGE / "compiled" / "__pycache__" / "rtcli-compiled.sha256"
-    try:
-        if stamp.exists() and stamp.read_text() == digest.hexdigest():
-            return
-        for folder in {f.parent / "__pycache__" for f in _sources()}:
-            for f in folder.glob("*.nb[ic]"):
+    for folders, used in cache_places():
+        stamp = folders[0] / STAMP
+        try:
+            if stamp.exists() and stamp.read_text() == digest.hexdigest():
+                continue
+            found = [f for folder in folders if folder.is_dir() for f in folder.glob("*.nb[ic]")]
+            for f in found:
                 f.unlink()
-        stamp.parent.mkdir(exist_ok=True)
-        stamp.write_text(digest.hexdigest())
-    except OSError:                    # a read-only install: numba keeps its cache elsewhere
-        pass
+            if used or found:
+                stamp.parent.mkdir(parents=True, exist_ok=True)
+                stamp.write_text(digest.hexdigest())
+        except OSError:                # not writable: numba cannot use it either
+            pass
 
 
 def _load() -> str | None:
@@ -126,16 +157,18 @@ def _load() -> str | None:
 AUTO_RAYS = 1_000_000
 
 
-def choose(scene, engine: str, rays: int = AUTO_RAYS, bvh: bool = True) -> Compiled | None:
+def choose(scene, engine: str, rays: int = AUTO_RAYS, bvh: bool = True, notes=None) -> Compiled | None:
     """The compiled engine for `scene`, or None for the numpy engine; RtcliError when
     `engine` is "compiled" and it cannot be had. `rays`: how many primary rays the job traces;
-    `bvh`: a BVH over the scene's objects when there are enough of them."""
+    `bvh`: a BVH over the scene's objects when there are enough of them; `notes`: where to say
+    that the engine is being compiled (loading.ready). Its `load` says how long it took to start."""
     if engine == "numpy" or (engine == "auto" and rays < AUTO_RAYS):
         return None
+    start = time.perf_counter()
     shape = unsupported(scene)
     why = f"it does not handle {shape} (--engine numpy does)" if shape else _load()
     if why is None:
-        return Compiled(scene, bvh)
+        return Compiled(scene, bvh, notes, start)
     if engine == "compiled":
         raise RtcliError(f"--engine compiled cannot render this scene: {why}")
     return None

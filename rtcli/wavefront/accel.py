@@ -87,7 +87,7 @@ class Accelerator:
             blocked[rows] = blocks(scene.objects[k], o[:, r[rows]], d[:, r[rows]], 0.0, 1.0)
         return select(blocked, 0.5, INF)
 
-    def _walk(self, scene, o, d, t_min, t_max, mode: int):
+    def compiled_walk(self, scene, o, d, t_min, t_max, mode: int):
         """The compiled walk over the scene's tree: (t, object, prim) per ray (mode: core/bvh.py)."""
         from rtcli.compiled import query
         from rtcli.compiled.pack import geometry
@@ -107,7 +107,7 @@ class Accelerator:
         hits = no_hits(len(rays), t_max)
         nearest_over(scene, self.unbounded, rays, t_min, hits, casters)
         if variants.ENABLED and self.all_spheres:
-            t, obj, sub = self._walk(scene, o, d, t_min, hits.t, NEAREST_CASTER if casters else NEAREST)
+            t, obj, sub = self.compiled_walk(scene, o, d, t_min, hits.t, NEAREST_CASTER if casters else NEAREST)
             won = obj >= 0
             hits.t[won], hits.obj[won], hits.prim[won] = t[won], obj[won], sub[won]
             return hits
@@ -126,7 +126,7 @@ class Accelerator:
         todo = np.flatnonzero(~blocked)
         p, dt = points[:, todo], d[:, todo]
         if variants.ENABLED and self.all_spheres:
-            blocked[todo] = self._walk(scene, p, dt, 0.0, 1.0, ANY_CASTER)[1] >= 0
+            blocked[todo] = self.compiled_walk(scene, p, dt, 0.0, 1.0, ANY_CASTER)[1] >= 0
         else:
             blocked[todo] = self.bvh.any_hit(p, dt, 0.0, 1.0, lambda r, m, t_max: self._pair_blocks(scene, p, dt, r, m))
         return blocked

@@ -63,7 +63,7 @@ def _walks_triangles(shape) -> bool:
     return shape.kernels is not None and shape.kernels.hit is None and variants.ENABLED
 
 
-def _compiled_walk(shape, o, d, t_min, t_max, shadow: bool):
+def compiled_walk(shape, o, d, t_min, t_max, shadow: bool):
     """The compiled walk over a mesh's tree for rays o, d (3, n): (t, face) or the blocked mask."""
     from rtcli.compiled import query
     from rtcli.compiled.pack import mesh_geometry
@@ -83,7 +83,7 @@ def object_hit(obj, o, d, t_min, t_max):
     """(t, prim) of one scene object for rays o + t d in world space."""
     o_obj, d_obj = to_object(obj, o, d)
     if _walks_triangles(obj.shape):
-        return _compiled_walk(obj.shape, o_obj, d_obj, t_min, t_max, False)
+        return compiled_walk(obj.shape, o_obj, d_obj, t_min, t_max, False)
     return obj.shape.hits(o_obj, d_obj, t_min, t_max)
 
 
@@ -91,7 +91,7 @@ def blocks(obj, o, d, t_min, t_max) -> np.ndarray:
     """(n,) bool: the rays o + t d hit object obj for t_min < t < t_max (any hit will do)."""
     o_obj, d_obj = to_object(obj, o, d)
     if _walks_triangles(obj.shape):
-        return _compiled_walk(obj.shape, o_obj, d_obj, t_min, t_max, True)
+        return compiled_walk(obj.shape, o_obj, d_obj, t_min, t_max, True)
     if hasattr(obj.shape, "any_hit"):                  # meshes stop at their first blocking triangle
         return obj.shape.any_hit(o_obj, d_obj, t_min, t_max)
     return np.isfinite(obj.shape.hits(o_obj, d_obj, t_min, t_max)[0])

@@ -1,0 +1,58 @@
+"""`rtcli warmup`: every compiled function the engines call, compiled now or loaded from the cache.
+
+The compiled engine calls one entry point, the integrator (trace_camera); the numpy engine
+calls two compiled walks, over a mesh's triangles and over a BVH of spheres. Each is called
+here once, through the engines' own code on two small scenes made in code, so with the same
+argument types as in any render: afterwards no render compiles (tests/test_startup.py renders
+every scene and checks that). A second warmup loads the code from the cache in well under a
+second and says that nothing was compiled.
+"""
+
+from __future__ import annotations
+
+import time
+from functools import partial
+
+import numpy as np
+
+from rtcli import variants
+from rtcli.compiled.loading import Load, ready
+
+
+def _scenes():
+    """(nine spheres over a plane: the integrator with a BVH, the walk over spheres; a mesh)."""
+    from rtcli.core.camera import from_fov
+    from rtcli.core.lights import PointLight
+    from rtcli.core.materials import Material, MaterialTable
+    from rtcli.core.scene import Scene, SceneObject
+    from rtcli.shapes.mesh import Mesh
+    from rtcli.shapes.plane import Plane
+    from rtcli.shapes.sphere import Sphere
+    camera = partial(from_fov, np.array([0.0, 2, 8]), np.zeros(3), [0, 1, 0], 40.0)
+    lights = [PointLight(np.array([4.0, 6, 4]), np.ones(3), np.array([1.0, 0, 0]))]
+    spheres = [SceneObject(k + 1, "", Sphere((k % 3 - 1.0, 0.5, k // 3 - 1.0), 0.4), 0) for k in range(9)]
+    floor = SceneObject(10, "", Plane((0, 0, 0)), 0)
+    materials = MaterialTable([Material()])
+    mesh = SceneObject(1, "", Mesh.examples()[0], 0)
+    return (Scene(camera, spheres + [floor], materials, lights, eye=np.array([0.0, 2, 8])),
+            Scene(camera, [mesh, floor], materials, lights, eye=np.array([0.0, 2, 8])))
+
+
+def warmup(notes=None) -> list[tuple[str, Load]]:
+    """Load or compile the machine code of every compiled entry point: (what, how long) for the
+    render engine and the numpy engine's walks. `notes` hears when one compiles (default: stderr).
+    RtcliError when numba cannot be loaded."""
+    from rtcli import compiled, wavefront
+    from rtcli.errors import RtcliError
+    if not variants.ENABLED:
+        raise RtcliError("numba is not installed: nothing to compile (the numpy engine needs none; "
+                         "pip install -e '.[fast]' in the rtcli folder for the compiled engine)")
+    spheres, mesh = _scenes()
+    engine = compiled.choose(spheres, "compiled", notes=notes)
+    start, found = time.perf_counter(), []
+    for scene in (spheres, mesh):
+        wavefront.build(scene)
+        found.append(wavefront.walks(scene))
+    entries = [e for scene_entries, _ in found for e in scene_entries]
+    walks = ready(entries, lambda: [call() for _, call in found], wavefront.WALKS, "about half a minute", notes, start)
+    return [("the render engine (compiled)", engine.load), (wavefront.WALKS, walks)]
