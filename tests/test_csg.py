@@ -7,7 +7,8 @@ import pytest
 
 from rtcli.core.transform import translate
 from rtcli.errors import SceneError
-from rtcli.shapes.csg import CSG, Child
+from rtcli.shapes.base import Shape
+from rtcli.shapes.csg import CSG, OPS, Child
 from rtcli.shapes.sphere import Sphere
 
 # Two unit spheres on the x axis, centres at x = 0 and x = 1: along the x axis from
@@ -124,3 +125,118 @@ def test_touching_solids_have_no_inner_face():
     np.testing.assert_allclose(spans_of("union", (left, right)), [(4, 6)])
     t, _ = CSG("union", [left, right]).intersect(np.array([[-0.5, 0, 0]]), D, np.array([0.0]), np.inf)
     assert t[0] == pytest.approx(1.5)
+
+
+# --- the span algebra, one ray at a time (the compiled engine's) against the arrays' (the numpy engine's) ---
+class Fixed(Shape):
+    """A solid whose spans are given: ray i (o[0] = i) has spans[i], (t_in, t_out) pairs; prims 10 k + j."""
+
+    def __init__(self, spans: np.ndarray, k: int):
+        self.given, self.k = spans, k
+        self.SPANS = spans.shape[1]
+
+    @property
+    def solid(self) -> bool:
+        return True
+
+    def spans_of(self, o, d):
+        rays = o[0].astype(int)
+        prims = np.broadcast_to(10 * self.k + np.arange(self.SPANS), (len(rays), self.SPANS))
+        return self.given[rays, :, 0], prims, self.given[rays, :, 1], prims + 100
+
+
+def random_tree(rng, leaves: list, n_rays: int, depth: int = 2):
+    """A random CSG over Fixed leaves whose span ends lie on a coarse grid (ties everywhere: equal
+    ends, touching spans, empty and zero-length spans, -inf and inf)."""
+    children = []
+    for _ in range(rng.integers(2, 5)):
+        if depth and rng.random() < 0.35:
+            children.append(Child(random_tree(rng, leaves, n_rays, depth - 1), None, 0))
+            continue
+        S = int(rng.integers(1, 3))
+        ends = rng.integers(0, 8, (n_rays, S, 2)).astype(float)
+        ends[rng.random((n_rays, S, 2)) < 0.05] = -np.inf
+        ends[rng.random((n_rays, S, 2)) < 0.05] = np.inf
+        ends = np.sort(ends.reshape(n_rays, -1), axis=1).reshape(n_rays, S, 2)     # spans in order
+        ends[rng.random((n_rays, S)) < 0.15] = np.inf                             # no span there
+        leaf = Fixed(ends, len(leaves))
+        leaves.append(leaf)
+        children.append(Child(leaf, None, 0))
+    return CSG(str(rng.choice(["union", "intersection", "difference"])), children)
+
+
+def program(csg: CSG, leaves: list) -> list:
+    """The postfix program of csg, as rtcli/compiled/pack.py writes it: ("leaf", k) and (op, n)."""
+    out = []
+    for child in csg.children:
+        out += program(child.shape, leaves) if isinstance(child.shape, CSG) else [("leaf", leaves.index(child.shape))]
+    return out + [(OPS.index(csg.op), len(csg.children))]
+
+
+def decode(csg: CSG, prim: int, leaves: list):
+    """The numpy engine's prim (child + C x the child's prim, nested) as (leaf, leaf's prim)."""
+    child = csg.children[prim % len(csg.children)]
+    if isinstance(child.shape, CSG):
+        return decode(child.shape, prim // len(csg.children), leaves)
+    return leaves.index(child.shape), prim // len(csg.children)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_one_ray_at_a_time_the_span_algebra_is_the_numpy_engines(seed):
+    """`combine` (plain Python here, compiled in the compiled engine) gives every ray the numpy
+    engine's spans, boundary for boundary with the same leaf and surface, and `nearest` its hit."""
+    from rtcli import variants
+    from rtcli.shapes import csg as algebra
+    combine, nearest = variants.python(algebra.combine), variants.python(algebra.nearest)
+    rng = np.random.default_rng(seed)
+    n, leaves = 60, []
+    tree = random_tree(rng, leaves, n)
+    code = program(tree, leaves)
+    o, d = np.array([np.arange(n), np.zeros(n), np.zeros(n)], float), np.ones((3, n))
+    t_in, p_in, t_out, p_out = tree.spans_of(o, d)
+    t_hit, p_hit = tree.hits(o, d, 2.0, np.inf)
+    capacity = sum(leaf.SPANS for leaf in leaves)
+    L = len(leaves)
+    for i in range(n):
+        bt, bid = np.zeros(2 * capacity), np.zeros(2 * capacity, np.int64)
+        et, ed, eo, ei = np.zeros(2 * capacity), *np.zeros((3, 2 * capacity), np.int64)
+        lists, counts, top, end = np.zeros(2 * L, np.int64), np.zeros(5, np.int64), 0, 0
+        for what, arg in code:
+            if what == "leaf":
+                leaf = leaves[arg]
+                for j in range(leaf.SPANS):
+                    bt[end:end + 2] = leaf.given[i, j]
+                    bid[end:end + 2] = arg + L * (10 * arg + j), arg + L * (10 * arg + j + 100)
+                    end += 2
+                lists[2 * top:2 * top + 2] = end - 2 * leaf.SPANS, 2 * leaf.SPANS
+                top += 1
+            else:
+                top = combine(what, arg, bt, bid, lists, top, et, ed, eo, ei, counts)
+                end = lists[2 * top - 2] + lists[2 * top - 1]
+        assert top == 1 and lists[0] == 0
+        mine = [(bt[j], divmod(bid[j], L)[::-1]) for j in range(lists[1])]
+        theirs = []
+        for j in range(t_in.shape[1]):
+            if np.isfinite(t_in[i, j]) or np.isfinite(t_out[i, j]) or p_in[i, j] or p_out[i, j]:
+                theirs += [(t_in[i, j], decode(tree, p_in[i, j], leaves)),
+                           (t_out[i, j], decode(tree, p_out[i, j], leaves))]
+        assert [(t, tuple(map(int, p))) for t, p in mine] == [(t, tuple(map(int, p))) for t, p in theirs], f"ray {i}"
+        t, ident = nearest(bt, bid, 0, lists[1], 2.0, np.inf)
+        assert t == t_hit[i] and (np.isinf(t) or (ident % L, ident // L) == decode(tree, p_hit[i], leaves))
+
+
+def test_the_numpy_engines_sort_is_precedes_order():
+    """CSG.spans_of sorts boundaries with lexsort on (t, -delta); that is `precedes`, stable."""
+    from rtcli.shapes.csg import precedes
+    rng = np.random.default_rng(1)
+    t = rng.integers(0, 4, 40).astype(float)
+    t[:3] = -np.inf
+    delta = rng.choice([-1, 1], 40)
+    order = list(np.lexsort((-delta, t)))
+    mine = []                                            # insertion, as combine's sorted_in
+    for e in range(40):
+        k = len(mine)
+        while k > 0 and precedes(t[e], delta[e], t[mine[k - 1]], delta[mine[k - 1]]):
+            k -= 1
+        mine.insert(k, e)
+    assert mine == order

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.compiled.pack import KIND, MATERIAL, XFORM
-from rtcli.compiled.query import NORMALS_ANY, UV_ANY, scene_hit
+from rtcli.compiled.pack import CSG_KIND, KIND, XFORM
+from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, material_of, scene_hit
 from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.camera import primary_ray
 from rtcli.core.dielectric import FEELER_CROSSINGS, fresnel, indices, refracted_media, split
@@ -51,7 +51,10 @@ def surface(g, k, prim, t, ox, oy, oz, dx, dy, dz):
     if x >= 0:
         ox, oy, oz, dx, dy, dz = ray_to_object(g.transforms[x], 0, ox, oy, oz, dx, dy, dz)
     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
-    nx, ny, nz, gx, gy, gz = NORMALS_ANY(g.ints[k, KIND], g.objects[k], g.pool, prim, px, py, pz)
+    if g.ints[k, KIND] == CSG_KIND:
+        nx, ny, nz, gx, gy, gz = csg_normals(g, prim, px, py, pz)
+    else:
+        nx, ny, nz, gx, gy, gz = NORMALS_ANY(g.ints[k, KIND], g.objects[k], g.pool, prim, px, py, pz)
     if x >= 0:
         nx, ny, nz = normal_to_world(g.transforms[x], 0, nx, ny, nz)
         gx, gy, gz = normal_to_world(g.transforms[x], 0, gx, gy, gz)
@@ -67,7 +70,9 @@ def texture_at(g, s, m, k, prim, px, py, pz):
     if tex[TEXTURE_KIND] == NONE:
         return 1.0, 1.0, 1.0
     u, v = 0.0, 0.0
-    if tex[TEXTURE_KIND] == IMAGE:
+    if tex[TEXTURE_KIND] == IMAGE and g.ints[k, KIND] == CSG_KIND:
+        u, v = csg_uv(g, prim, px, py, pz)
+    elif tex[TEXTURE_KIND] == IMAGE:
         u, v = UV_ANY(g.ints[k, KIND], g.objects[k], g.pool, prim, px, py, pz)
     return texture_color(tex, s.texels, px, py, pz, u, v)
 
@@ -83,10 +88,10 @@ def transmittance(g, s, sx, sy, sz, dx, dy, dz, stack):
         return 1.0, 1.0, 1.0
     Tr, Tg, Tb, t0 = 1.0, 1.0, 1.0, 0.0
     for _ in range(FEELER_CROSSINGS):
-        t, k, _ = scene_hit(g, sx, sy, sz, dx, dy, dz, t0, 1.0, NEAREST_CASTER, stack)
+        t, k, prim = scene_hit(g, sx, sy, sz, dx, dy, dz, t0, 1.0, NEAREST_CASTER, stack)
         if k < 0:
             return Tr, Tg, Tb
-        m = g.ints[k, MATERIAL]
+        m = material_of(g, k, prim)
         if not s.filters[m]:
             return 0.0, 0.0, 0.0
         Tr, Tg, Tb, t0 = Tr * s.kt[m, 0], Tg * s.kt[m, 1], Tb * s.kt[m, 2], t
@@ -134,7 +139,7 @@ def shade_local(g, s, ray, f, counts, stack):
     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
     nx, ny, nz, gx, gy, gz, qx, qy, qz = surface(g, k, prim, t, ox, oy, oz, dx, dy, dz)
     nx, ny, nz, gx, gy, gz, entering = facing(dx, dy, dz, nx, ny, nz, gx, gy, gz)
-    m = g.ints[k, MATERIAL]
+    m = material_of(g, k, prim)
     Dx, Dy, Dz = unit(dx, dy, dz)
     Tr, Tg, Tb = texture_at(g, s, m, k, prim, qx, qy, qz)
     cr, cg, cb = local(g, s, m, Tr, Tg, Tb, px, py, pz, nx, ny, nz, gx, gy, gz, -Dx, -Dy, -Dz, counts, stack)

@@ -1,15 +1,17 @@
 """A Scene as flat arrays for the compiled engine, or the reason it cannot be.
 
 The compiled engine renders every shape of the registry (rtcli/shapes/), each with
-any transform; checker and image textures; point, spot and area lights. A CSG has no
-kernels and keeps the numpy engine: `unsupported(scene)` names it.
+any transform, and CSG; checker and image textures; point, spot and area lights.
 
 Geometry (`Geometry`), one row per scene object:
-- `objects` (N, SHAPE_WIDTH): the shape's row (rtcli/shapes/, its own layout);
-- `ints` (N, 4), by the names KIND (the shape's place in the registry), XFORM (its
-  row of `transforms`, -1 for none), CASTS (its material casts shadows) and MATERIAL;
+- `objects` (N + L, SHAPE_WIDTH): the shape's row (rtcli/shapes/, its own layout), or
+  a csg's (the columns PROGRAM ... HI below); then the shape rows of the L csg leaves;
+- `ints` (N, 4), by the names KIND (the shape's place in the registry, CSG_KIND for a
+  csg), XFORM (its row of `transforms`, -1 for none), CASTS (its material casts
+  shadows) and MATERIAL;
 - `transforms` (T, 36): the packed transforms (rtcli/core/transform.py) of the
-  objects that have one, so that a scene of a million plain spheres pays nothing;
+  objects that have one, so that a scene of a million plain spheres pays nothing, and
+  of the csg children that have one;
 - `listed`: the objects tested one by one: the unbounded ones (planes), or, as the
   numpy engine does for a scene without a BVH (Scene.wants_bvh: fewer than 8
   bounded objects, or --no-bvh), every object in file order, so that ties go the
@@ -17,7 +19,14 @@ Geometry (`Geometry`), one row per scene object:
 - `nodes`, `links`, `perm`: BVH trees one after another (rtcli/core/bvh.py's layout),
   the scene's over the other objects first (root 0), then each mesh's over its faces;
 - `pool`: the rows shapes own (polygon vertices, triangles); a shape's row says where
-  its own start (FIRST_COLUMN) and a mesh's where its tree's root is (ROOT_COLUMN).
+  its own start (FIRST_COLUMN) and a mesh's where its tree's root is (ROOT_COLUMN);
+- `program` (P, 2): each csg's tree as a postfix program, one after another: (LEAF, l)
+  puts leaf l's spans on the stack, (op, n) (csg.UNION, INTERSECTION, DIFFERENCE)
+  replaces the top n span lists by their combination;
+- `leaves` (L, 4 + 2 D): each csg leaf's KIND, ROW (its shape row in `objects`), DEPTH
+  (the csg children on its path from the csg), MATERIAL, then for each of those children,
+  outermost first, its transform (-1: none) and FLIP (-1 for a difference's later
+  child, else 1). A csg hit's prim is leaf + L x (the leaf's surface).
 
 Looks (`Looks`): the MaterialTable's arrays under the names the shading kernels read
 (rtcli/core/shading.py), its texture rows and texels, the lights' rows and sample
@@ -30,18 +39,26 @@ from collections import namedtuple
 
 import numpy as np
 
-from rtcli.core.bvh import BVH
+from rtcli.core.bvh import BVH, padded
 from rtcli.core.scene import object_tree
 from rtcli.core.transform import PACKED
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import POOL_WIDTH
+from rtcli.shapes.csg import CSG, OPS
 
 SHAPE_WIDTH = 20                                   # columns of an object row: the widest shape's row
 KIND, XFORM, CASTS, MATERIAL = range(4)            # columns of ints
 KINDS = {cls: k for k, cls in enumerate(SHAPES.values())}
+CSG_KIND = len(KINDS)
+# A csg's row: where its program starts and how long it is, its leaf count, how many spans its
+# leaves can give (SPANS: the capacity of its span lists), its largest number of children, its
+# scratch (in the traversal stack), and its object-space box (BOUNDED 0: none).
+PROGRAM, LENGTH, LEAF_COUNT, SPANS, CHILDREN, SCRATCH, BOUNDED, LO, HI = 0, 1, 2, 3, 4, 5, 6, 7, 10
+LEAF = len(OPS)                                    # the program's code for a leaf (the ops are csg's)
+ROW, DEPTH, PATH = 1, 2, 4                         # columns of leaves (KIND and MATERIAL as in ints)
 
 # Few arrays on purpose: numba passes each array argument as several machine words.
-Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool")
+Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool program leaves")
 Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear fresnel filters texture "
                             "texels lights samples ambient background offset max_depth blinn medium_ior "
                             "reflect_tir any_filter")
@@ -50,9 +67,66 @@ Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror 
 def unsupported(scene) -> str | None:
     """Why the compiled engine cannot render `scene`, or None when it can."""
     for o in scene.objects:
-        if type(o.shape) not in KINDS:
+        if type(o.shape) not in KINDS and not isinstance(o.shape, CSG):
             return f"{o.kind or type(o.shape).__name__} objects"
     return None
+
+
+def scratch(leaves: int, spans: int, children: int) -> int:
+    """Words of the traversal stack a csg's evaluation takes (query.csg_spans lays them out): a
+    start and length per span list (at most one list per leaf), two boundaries per span in the
+    lists and again among the sorted boundaries, with each boundary's t, leaf and surface (and
+    direction and child when sorted), and a count per child."""
+    return 2 * leaves + 4 * spans + 8 * spans + children
+
+
+class _CSGs:
+    """The csg objects' programs and leaves, as packed rows."""
+
+    def __init__(self, first_row: int):
+        self.program, self.leaves, self.rows, self.first_row = [], [], [], first_row
+
+    def add(self, csg: CSG, transforms: list) -> np.ndarray:
+        """Append csg's program and leaves (their transforms to `transforms`); its object row."""
+        start, first_leaf = len(self.program), len(self.leaves)
+        children = self._emit(csg, (), transforms)
+        leaves = len(self.leaves) - first_leaf
+        spans = sum(type(shape).SPANS for shape in self.rows[first_leaf:])
+        row = np.zeros(SHAPE_WIDTH)
+        row[[PROGRAM, LENGTH, LEAF_COUNT, SPANS, CHILDREN, SCRATCH]] = (
+            start, len(self.program) - start, leaves, spans, children, scratch(leaves, spans, children))
+        box = csg.bounds()
+        if box is not None:
+            lo, hi = padded(*box)
+            row[BOUNDED], row[LO:LO + 3], row[HI:HI + 3] = 1, lo, hi
+        return row
+
+    def _emit(self, csg: CSG, path: tuple, transforms: list) -> int:
+        """The postfix program of csg at `path` ((transform, flip) per csg child above it); its
+        largest number of children."""
+        widest = len(csg.children)
+        for c, child in enumerate(csg.children):
+            x = -1
+            if child.transform is not None:
+                transforms.append(child.transform.packed)
+                x = len(transforms) - 1
+            here = path + ((x, -1 if csg.op == "difference" and c > 0 else 1),)
+            if isinstance(child.shape, CSG):
+                widest = max(widest, self._emit(child.shape, here, transforms))
+                continue
+            self.program.append((LEAF, len(self.leaves)))
+            self.leaves.append((KINDS[type(child.shape)], self.first_row + len(self.rows), child.material, here))
+            self.rows.append(child.shape)
+        self.program.append((OPS.index(csg.op), len(csg.children)))
+        return widest
+
+    def arrays(self):
+        depth = max((len(path) for *_, path in self.leaves), default=0)
+        leaves = np.zeros((len(self.leaves), PATH + 2 * depth), dtype=np.int64)
+        for j, (kind, row, material, path) in enumerate(self.leaves):
+            leaves[j, :PATH] = kind, row, len(path), material
+            leaves[j, PATH:PATH + 2 * len(path)] = np.ravel(path)
+        return np.array(self.program, dtype=np.int64).reshape(-1, 2), leaves
 
 
 class _Trees:
@@ -89,11 +163,13 @@ def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int
     listed = np.flatnonzero(~bounded | (not tree))
     members, scene_bvh = (bvh or object_tree(scene)) if tree else (np.zeros(0, np.int64), BVH(np.zeros((0, 3)),
                                                                                              np.zeros((0, 3))))
-    trees, mesh_depth, transforms = _Trees(), 0, []
+    trees, mesh_depth, transforms, csgs, csg_scratch = _Trees(), 0, [], _CSGs(n), 0
     trees.add(scene_bvh, members)                    # root 0
     pool, n_pool = [np.zeros((0, POOL_WIDTH))], 0
-    for k, o in enumerate(scene.objects):
-        shape = o.shape
+
+    def shape_row(shape) -> np.ndarray:
+        """The shape's row, its pool appended (its rows' start, a mesh's tree root written in)."""
+        nonlocal mesh_depth, n_pool
         row = np.array(shape.row, dtype=float)
         if shape.FIRST_COLUMN is not None:
             row[shape.FIRST_COLUMN] = n_pool
@@ -102,24 +178,40 @@ def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int
             mesh_depth = max(mesh_depth, shape.bvh.depth)
         if len(row) > SHAPE_WIDTH:
             raise ValueError(f"a {type(shape).__name__} row is wider than {SHAPE_WIDTH} columns")
-        objects[k, :len(row)] = row
         if len(shape.pool):
             pool.append(shape.pool)
             n_pool += len(shape.pool)
+        return row
+
+    for k, o in enumerate(scene.objects):
+        shape = o.shape
+        if isinstance(shape, CSG):
+            objects[k], kind = csgs.add(shape, transforms), CSG_KIND
+            csg_scratch = max(csg_scratch, int(objects[k, SCRATCH]))
+        else:
+            row, kind = shape_row(shape), KINDS[type(shape)]
+            objects[k, :len(row)] = row
         if o.transform is not None:
             transforms.append(o.transform)
-        ints[k] = KINDS[type(shape)], len(transforms) - 1 if o.transform is not None else -1, \
+        ints[k] = kind, len(transforms) - 1 if o.transform is not None else -1, \
             scene.materials.shadow[o.material], o.material
+    if csgs.rows:
+        leaf_rows = np.zeros((len(csgs.rows), SHAPE_WIDTH))
+        for j, shape in enumerate(csgs.rows):
+            row = shape_row(shape)
+            leaf_rows[j, :len(row)] = row
+        objects = np.concatenate([objects, leaf_rows])
     geo = Geometry(objects, ints, np.array(transforms).reshape(-1, PACKED), listed.astype(np.int64),
-                   *trees.arrays(), np.ascontiguousarray(np.concatenate(pool)))
-    return geo, scene_bvh.depth + mesh_depth + 4
+                   *trees.arrays(), np.ascontiguousarray(np.concatenate(pool)), *csgs.arrays())
+    return geo, scene_bvh.depth + max(mesh_depth, csg_scratch) + 4
 
 
 def mesh_geometry(mesh) -> Geometry:
     """One mesh's faces and tree (root 0) as a Geometry, for the compiled walk over its triangles."""
     none = np.zeros(0, dtype=np.int64)
     return Geometry(np.zeros((0, SHAPE_WIDTH)), np.zeros((0, 4), dtype=np.int64), np.zeros((0, PACKED)), none,
-                    mesh.bvh.nodes, mesh.bvh.links, mesh.bvh.perm, np.ascontiguousarray(mesh.pool))
+                    mesh.bvh.nodes, mesh.bvh.links, mesh.bvh.perm, np.ascontiguousarray(mesh.pool),
+                    np.zeros((0, 2), dtype=np.int64), np.zeros((0, PATH), dtype=np.int64))
 
 
 def looks(scene) -> Looks:

@@ -3,9 +3,10 @@
 Each child reports the intervals of each ray that lie inside it (its hit list,
 with isEntering: a span's start enters, its end leaves). The CSG merges all
 children's boundaries in order of t, tracks which children each stretch of the
-ray is inside, and keeps the boundaries where the boolean result switches.
-Normals of carved surfaces (a difference's later children) are flipped, so they
-point out of the result. Children keep their own transform and material.
+ray is inside, and keeps the boundaries where the boolean result switches (Roth's
+ray casting of solids, with span lists). Normals of carved surfaces (a difference's
+later children) are flipped, so they point out of the result. Children keep their
+own transform and material.
 
 YAML: `csg: {difference: [object, object, ...]}` (or `union:` / `intersection:`);
 children are objects (with `transform:` and `material:`, no `name` needed);
@@ -13,11 +14,14 @@ difference = first child minus all the others. Children must be solids: sphere,
 plane (the half-space behind its normal), box, cylinder, cone, torus or csg.
 The checker texture of a csg is evaluated in the csg's own object space.
 
-Only the numpy engine renders a CSG: merging a variable number of spans per ray
-is sorting and counting over whole arrays, which numpy does at once; the compiled
-engine, one ray at a time, would need per-ray lists of spans (docs/architecture.md).
-So a CSG has no kernels; it answers the numpy engine's methods (Shape.hits, ...)
-from its children's kernels.
+The span algebra is written once, for both engines: a span's two boundaries
+(`boundaries`), their order along the ray (`precedes`) and the boolean rule
+(`classify`) are kernels; the numpy engine applies them to whole arrays of rays (a
+sort and a cumulative sum, `CSG.spans_of`), the compiled engine one ray at a time,
+with `combine` merging span lists held in a fixed scratch buffer (the tree packed
+as a postfix program: rtcli/compiled/pack.py, query.py). A CSG has no row of its
+own: it answers the numpy engine's methods (Shape.hits, ...) from its children's
+kernels.
 """
 
 from __future__ import annotations
@@ -35,8 +39,102 @@ from rtcli.core.transform import (
     outer_bounds,
 )
 from rtcli.shapes.base import Shape
+from rtcli.variants import INF, kernel, per_ray, select
 
 OPS = ("union", "intersection", "difference")
+UNION, INTERSECTION, DIFFERENCE = range(3)           # OPS's codes (the compiled program's too)
+
+
+# --- the span algebra: kernels both engines call ---
+@kernel
+def boundaries(t_in, t_out):
+    """A span [t_in, t_out] as two boundaries of a hit list, (t, +1) entering and (t, -1) leaving;
+    an empty span (t_in >= t_out, or NaN: no interval there) gives none, (inf, 0) twice."""
+    valid = t_in < t_out
+    return select(valid, t_in, INF), select(valid, 1, 0), select(valid, t_out, INF), select(valid, -1, 0)
+
+
+@kernel
+def precedes(t1, delta1, t2, delta2):
+    """Whether boundary 1 comes before boundary 2 along the ray: by t, and at the same t entering
+    before leaving, so two solids that touch leave no gap there. Equal ones keep their order (the
+    children's, then each child's entries before its exits)."""
+    return (t1 < t2) | ((t1 == t2) & (delta1 > delta2))
+
+
+@kernel
+def classify(op, inside, first, children):
+    """Whether a stretch of the ray lies in op(children), when it lies in `inside` of the
+    `children` (`first`: in the first one): union any, intersection all, difference the first
+    and no other."""
+    if op == UNION:
+        return inside > 0
+    if op == INTERSECTION:
+        return inside == children
+    return first & (inside == 1)
+
+
+@per_ray(inline=True)
+def sorted_in(t, delta, owner, ident, et, ed, eo, ei, e):
+    """Boundary (t, delta) of child `owner` (`ident`: its leaf and surface) put among the e sorted
+    ones in et, ed, eo, ei by insertion (stable: it goes after the equal ones); returns e + 1."""
+    k = e
+    while k > 0 and precedes(t, delta, et[k - 1], ed[k - 1]):
+        et[k], ed[k], eo[k], ei[k] = et[k - 1], ed[k - 1], eo[k - 1], ei[k - 1]
+        k -= 1
+    et[k], ed[k], eo[k], ei[k] = t, delta, owner, ident
+    return e + 1
+
+
+@per_ray
+def combine(op, n, bt, bid, lists, top, et, ed, eo, ei, counts):
+    """One ray's span lists of the n children of an op(children) node merged into the node's list
+    (Roth: the children's boundaries in order along the ray, a count of the children each stretch is
+    inside, a boundary of the result wherever `classify` changes).
+
+    A list is boundaries in bt (t) and bid (which leaf and surface): entering, leaving, entering...;
+    lists[2 j], lists[2 j + 1] are list j's start and length, lists top - n ... top - 1 the
+    children's, one after another. The node's list replaces them (it is never longer); the new top
+    is returned. et, ed, eo, ei hold the sorted boundaries, counts one count per child: scratch."""
+    first = top - n
+    start, e = lists[2 * first], 0
+    for c in range(n):
+        counts[c] = 0
+        at, length = lists[2 * (first + c)], lists[2 * (first + c) + 1]
+        for j in range(at, at + length, 2):                    # entries first, then exits (the numpy
+            t_in, d_in, t_out, d_out = boundaries(bt[j], bt[j + 1])       # engine's order of ties)
+            if d_in != 0:
+                e = sorted_in(t_in, d_in, c, bid[j], et, ed, eo, ei, e)
+        for j in range(at, at + length, 2):
+            t_in, d_in, t_out, d_out = boundaries(bt[j], bt[j + 1])
+            if d_out != 0:
+                e = sorted_in(t_out, d_out, c, bid[j + 1], et, ed, eo, ei, e)
+    inside, first_inside, now, out = 0, False, False, start
+    for k in range(e):
+        c = eo[k]
+        was = counts[c] > 0
+        counts[c] += ed[k]
+        if (counts[c] > 0) != was:
+            inside += -1 if was else 1
+            if c == 0:
+                first_inside = not was
+        after = classify(op, inside, first_inside, n)
+        if after != now:
+            bt[out], bid[out], now, out = et[k], ei[k], after, out + 1
+    lists[2 * first + 1] = out - start
+    return first + 1
+
+
+@per_ray(inline=True)
+def nearest(bt, bid, start, length, t_min, t_max):
+    """(t, ident) of the first boundary of a list in (t_min, t_max), inf if none: entering ones
+    first, then leaving ones, the first of equals (as the numpy engine's argmin)."""
+    best, won = INF, 0
+    for half in range(2):
+        for j in range(start + half, start + length, 2):
+            if bt[j] > t_min and bt[j] < t_max and bt[j] < best:
+                best, won = bt[j], bid[j]
+    return best, won
 
 
 @dataclass(frozen=True)
@@ -65,23 +163,16 @@ class CSG(Shape):
     def solid(self) -> bool:
         return True
 
-    def _result(self, inside: np.ndarray) -> np.ndarray:
-        """The boolean op on per-child inside flags (..., C)."""
-        if self.op == "union":
-            return inside.any(axis=-1)
-        if self.op == "intersection":
-            return inside.all(axis=-1)
-        return inside[..., 0] & ~inside[..., 1:].any(axis=-1)
-
     def _events(self, o, d):
-        """All children's span boundaries: t (n, E), +1/-1 enter/leave, child (E,), encoded prim (n, E)."""
+        """All children's span boundaries: t (n, E), +1/-1 enter/leave (0: none), child (E,),
+        encoded prim (n, E); each child's entries, then its exits."""
         C = len(self.children)
         ts, deltas, owners, prims = [], [], [], []
         for c, child in enumerate(self.children):
             t_in, p_in, t_out, p_out = child.shape.spans_of(*child.to_child(o, d))
-            valid = t_in < t_out
-            ts += [np.where(valid, t_in, np.inf), np.where(valid, t_out, np.inf)]
-            deltas += [valid.astype(np.int64), -valid.astype(np.int64)]
+            t_in, d_in, t_out, d_out = boundaries(t_in, t_out)
+            ts += [t_in, t_out]
+            deltas += [d_in, d_out]
             owners += [np.full(t_in.shape[1], c)] * 2
             prims += [p_in * C + c, p_out * C + c]
         return (np.concatenate(ts, axis=1), np.concatenate(deltas, axis=1),
@@ -89,12 +180,12 @@ class CSG(Shape):
 
     def spans_of(self, o, d):
         t, delta, owner, prim = self._events(o, d)
-        order = np.lexsort((-delta, t), axis=1)         # by t; at equal t, entries before exits
+        order = np.lexsort((-delta, t), axis=1)         # `precedes`' order: by t, entries first; stable
         t, delta, prim = (np.take_along_axis(a, order, axis=1) for a in (t, delta, prim))
         owner = owner[order]
         inside = np.stack([np.cumsum(np.where(owner == c, delta, 0), axis=1) > 0
                            for c in range(len(self.children))], axis=-1)
-        now = self._result(inside)
+        now = classify(OPS.index(self.op), inside.sum(axis=-1), inside[..., 0], len(self.children))
         before = np.concatenate([np.zeros((o.shape[1], 1), bool), now[:, :-1]], axis=1)
         t_in, p_in = _compact(now & ~before, t, prim)
         t_out, p_out = _compact(~now & before, t, prim)
