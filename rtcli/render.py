@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli import compiled, wavefront
+from rtcli import compiled, variants, wavefront
 from rtcli.core.camera import primary_ray
 from rtcli.core.jitter import hash_pixel
 from rtcli.core.scene import Scene
@@ -169,10 +169,21 @@ def prepare(scene: Scene, job: Job, traced: int, notes=None):
     """(engine, load): the compiled engine for the job (rtcli.compiled.choose), or None with the
     scene readied for the numpy engine; and how long loading compiled code took (None when
     nothing was loaded). `notes` is told when it compiles."""
-    engine = None if job.signature else compiled.choose(scene, job.engine, traced, job.bvh, notes)
+    engine = None if job.signature else compiled.choose(scene, job.engine, _weighed(scene, job, traced), job.bvh,
+                                                         notes)
     if engine:
         return engine, engine.load
     return None, wavefront.prepare(scene, job.bvh, notes)
+
+
+def _weighed(scene: Scene, job: Job, traced: int) -> int:
+    """The rays `auto` weighs: a small job takes the numpy engine to spare numba's start-up, unless
+    that engine would load compiled BVH walks anyway (meshes, sets of spheres): then the compiled
+    engine starts as fast and traces faster, so the job counts as a large one."""
+    if job.engine != "auto" or traced >= compiled.AUTO_RAYS or not variants.ENABLED:
+        return traced
+    wavefront.build(scene, job.bvh)
+    return compiled.AUTO_RAYS if wavefront.uses_compiled_walks(scene) else traced
 
 
 def run_tiles(scene: Scene, engine, job: Job, tiles: list) -> list:

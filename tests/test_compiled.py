@@ -567,3 +567,16 @@ def test_the_csg_scene_at_its_own_size():
     a, b, sa, sb = both(scene, 480, 320)
     assert np.array_equal(a, b), f"{np.count_nonzero((a != b).any(axis=2))} pixels differ"
     assert (sa.shadow, sa.reflected, sa.refracted) == (sb.shadow, sb.reflected, sb.refracted)
+
+
+def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_anyway():
+    """Below AUTO_RAYS, `auto` stays on numpy for plain scenes, but a mesh (or a set of spheres)
+    makes the numpy engine load compiled walks itself, so the compiled engine is taken."""
+    from rtcli.render import prepare
+    small = fast.AUTO_RAYS // 2
+    for name, expected in (("scenes/whitted.yaml", None), ("bench/torus100k.yaml", fast.Compiled),
+                           ("bench/spheres1k.yaml", fast.Compiled)):
+        scene = load_scene(str(ROOT / name))
+        engine, _ = prepare(scene, Job(64, 48, engine="auto"), small)
+        assert (engine is None) if expected is None else isinstance(engine, expected), name
+        assert prepare(scene, Job(64, 48, engine="numpy"), small)[0] is None

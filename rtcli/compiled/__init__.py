@@ -15,7 +15,9 @@ so `drop_stale_cache` empties it whenever any source the engine is made of chang
 
 Loading numba and the cached code takes about 0.8 s, more than the numpy engine
 needs for a small image, so `auto` takes the compiled engine only from
-AUTO_RAYS primary rays up (a 1280x800 image, or 640x480 with --samples 2).
+AUTO_RAYS primary rays up (a 1280x800 image, or 640x480 with --samples 2), and for any
+size when the numpy engine would load compiled BVH walks itself (meshes, sets of
+spheres; rtcli/render.py).
 """
 
 from __future__ import annotations
