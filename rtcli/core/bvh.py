@@ -24,6 +24,7 @@ Two walks of the same tree, through the same slab test (`slab`):
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -56,6 +57,11 @@ class BVH:
         n_lo, n_hi = padded(n_lo, n_hi, self.box)
         self.nodes = np.ascontiguousarray(np.concatenate([n_lo, n_hi], axis=1))
         self.links = np.ascontiguousarray(np.stack([child, start, count], axis=1), dtype=np.int64)
+
+    @functools.cached_property
+    def _columns(self) -> np.ndarray:
+        """The node boxes as (6, nodes) rows (lo x, y, z, hi x, y, z), for the numpy walk's gathers."""
+        return np.ascontiguousarray(self.nodes.T)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """The union of the primitives' boxes (inf, -inf when there are none)."""
@@ -111,7 +117,7 @@ class BVH:
             inv = 1.0 / d
         for s in range(0, n, CHUNK):
             rays = np.arange(s, min(s + CHUNK, n))
-            rays = rays[self._meets(o, inv, rays, np.zeros(len(rays), np.int64), t_min, far)]
+            rays = rays[self._meets(np.zeros(len(rays), np.int64), *self._gather(o, inv, rays, t_min, far))]
             nodes = np.zeros(len(rays), dtype=np.int64)                              # the root
             while len(rays):
                 child = self.links[nodes, CHILD]
@@ -119,16 +125,20 @@ class BVH:
                 if leaf.any():
                     leaves(*self._leaf_pairs(rays[leaf], nodes[leaf]))
                 rays, left = rays[~leaf], child[~leaf]
-                hit_l = self._meets(o, inv, rays, left, t_min, far)
-                hit_r = self._meets(o, inv, rays, left + 1, t_min, far)
+                ray = self._gather(o, inv, rays, t_min, far)           # once for both children
+                hit_l, hit_r = self._meets(left, *ray), self._meets(left + 1, *ray)
                 rays, nodes = np.concatenate([rays[hit_l], rays[hit_r]]), np.concatenate([left[hit_l], left[hit_r] + 1])
 
-    def _meets(self, o, inv, rays, nodes, t_min, far):
-        """Whether each ray meets its node's box within [t_min, far]."""
-        box = self.nodes[nodes]
-        near = t_min if t_min.ndim == 0 else t_min[rays]
+    @staticmethod
+    def _gather(o, inv, rays, t_min, far):
+        """The rays' origins, inverse directions, near and far limits (far read live)."""
+        return o[:, rays], inv[:, rays], t_min if t_min.ndim == 0 else t_min[rays], far[rays]
+
+    def _meets(self, nodes, o, inv, near, far):
+        """Whether each ray meets its node's box within [near, far] (the rays gathered)."""
+        box = np.take(self._columns, nodes, axis=1)            # (6, k): each bound contiguous
         with np.errstate(invalid="ignore"):
-            t_in, t_out = slab(*box.T, *o[:, rays], *inv[:, rays], near, far[rays])
+            t_in, t_out = slab(*box, *o, *inv, near, far)
         return t_in <= t_out
 
     def _leaf_pairs(self, rays, nodes):
