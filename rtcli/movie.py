@@ -10,12 +10,12 @@ then (3 bytes a pixel a frame, checked by `check_size`).
 from __future__ import annotations
 
 import os
-import tempfile
 
 import numpy as np
 from PIL import Image
 
 from rtcli.errors import RtcliError, quoted, shown
+from rtcli.writer import write_temp
 
 FORMATS = {".apng": "PNG", ".gif": "GIF"}
 MAX_BYTES = 4 << 30                       # frames held in memory for one movie
@@ -48,23 +48,13 @@ def write_movie(path: str, frames: list[np.ndarray], fps: float) -> None:
     """Write uint8 (H, W, 3) frames as a movie at `fps` frames a second, looping."""
     fmt = movie_format(path)
     images = [Image.fromarray(f) for f in frames]
-    folder = os.path.dirname(os.path.abspath(path))
     try:
-        fd, tmp = tempfile.mkstemp(prefix=".rtcli-", suffix=os.path.splitext(path)[1], dir=folder)
-    except OSError as e:
-        raise RtcliError(f"cannot write {shown(path)}: {e.strerror}") from None
-    try:
-        with os.fdopen(fd, "wb") as f:
-            images[0].save(f, format=fmt, save_all=True, append_images=images[1:], duration=1000 / fps, loop=0)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, path)
-    except BaseException as e:
+        tmp = write_temp(path, lambda f: images[0].save(f, format=fmt, save_all=True, append_images=images[1:],
+                                                        duration=1000 / fps, loop=0))
         try:
+            os.replace(tmp, path)
+        except BaseException:
             os.unlink(tmp)
-        except OSError:
-            pass
-        if isinstance(e, OSError):
-            raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
-        raise
+            raise
+    except OSError as e:
+        raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None

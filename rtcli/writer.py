@@ -115,6 +115,12 @@ def _write_temp(path: str, pixels: np.ndarray) -> str:
         raise ValueError(f"cannot write {pixels.dtype} pixels of shape {pixels.shape} as an image")
     fmt, options = image_format(path, ids=pixels.dtype == np.uint16)
     img = Image.fromarray(pixels)                      # uint16 (H, W) -> I;16, uint8 (H, W, 3) -> RGB
+    return write_temp(path, lambda f: img.save(f, format=fmt, **options))
+
+
+def write_temp(path: str, save) -> str:
+    """A new temporary file beside `path`, filled by save(file object) and given the mode a plain
+    open() would; its name. Nothing is left behind when save fails."""
     folder = os.path.dirname(os.path.abspath(path))
     try:
         fd, tmp = tempfile.mkstemp(prefix=".rtcli-", suffix=os.path.splitext(path)[1], dir=folder)
@@ -122,7 +128,7 @@ def _write_temp(path: str, pixels: np.ndarray) -> str:
         raise RtcliError(f"cannot write {shown(path)}: {e.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as f:
-            img.save(f, format=fmt, **options)
+            save(f)
         os.chmod(tmp, 0o666 & ~current_umask())               # as a plain open() would (mkstemp makes 0600)
     except BaseException:
         _remove(tmp)

@@ -110,25 +110,24 @@ def real_path(path: str) -> str:
 
 
 @contextlib.contextmanager
+def _set(var: contextvars.ContextVar, value):
+    """`var` is `value` inside the block, which gets `value`."""
+    token = var.set(value)
+    try:
+        yield value
+    finally:
+        var.reset(token)
+
+
 def collecting():
     """Keeps, in a dict path -> (real path, bytes), every file read inside the block."""
-    kept: dict = {}
-    token = _kept.set(kept)
-    try:
-        yield kept
-    finally:
-        _kept.reset(token)
+    return _set(_kept, {})
 
 
-@contextlib.contextmanager
 def serving(files: dict):
     """Inside the block, files are read from `files` (path -> (real path, bytes), as `collecting`
     keeps them) instead of the disk; a path it lacks is not found."""
-    token = _served.set(files)
-    try:
-        yield
-    finally:
-        _served.reset(token)
+    return _set(_served, files)
 
 
 def _record(path: str) -> None:
@@ -137,15 +136,9 @@ def _record(path: str) -> None:
         read.append(os.path.realpath(path))
 
 
-@contextlib.contextmanager
 def recording_inputs():
     """Collects the real path of every input checked inside the block, in a list."""
-    read: list[str] = []
-    token = _read.set(read)
-    try:
-        yield read
-    finally:
-        _read.reset(token)
+    return _set(_read, [])
 
 
 def stamp(st: os.stat_result | None):
@@ -160,17 +153,11 @@ def _stamp(path: str, st: os.stat_result | None) -> None:
         stamps.setdefault(os.path.realpath(path), stamp(st))
 
 
-@contextlib.contextmanager
 def recording_stamps():
     """Collects, in a dict by real path, the stamp of every input checked inside the block as it
     was when checked, and None for one looked for and not found (the load then fails): what
     `rtcli render --watch` compares to see a change, even one made while it rendered."""
-    stamps: dict = {}
-    token = _stamps.set(stamps)
-    try:
-        yield stamps
-    finally:
-        _stamps.reset(token)
+    return _set(_stamps, {})
 
 
 @contextlib.contextmanager
