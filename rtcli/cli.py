@@ -174,7 +174,8 @@ def _size(model, width, height) -> tuple[int, int]:
 @click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")
 @click.option("--json", "as_json", is_flag=True, help="With --stats: one JSON object per scene, one a line.")
 @click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
-              help="numpy core, or compiled integrator (numba); auto: compiled for big jobs it can render.")
+              help="numpy core, or compiled integrator (numba); auto: compiled for big jobs, and for small "
+                   "ones with meshes or many spheres once it is compiled.")
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects: test each against every ray (for comparisons).")
 @click.option("--view", type=click.Choice(VIEWS), help="Write a debug view instead of the image (default name "
               "NAME.VIEW.png): outward normals, depth, uv, albedo (kd T), bounces or the signature ids.")

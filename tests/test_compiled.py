@@ -5,6 +5,9 @@ The first test to run compiles the integrator (about 30 s) unless numba's cache 
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -569,10 +572,12 @@ def test_the_csg_scene_at_its_own_size():
     assert (sa.shadow, sa.reflected, sa.refracted) == (sb.shadow, sb.reflected, sb.refracted)
 
 
-def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_anyway():
+def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_anyway(monkeypatch):
     """Below AUTO_RAYS, `auto` stays on numpy for plain scenes, but a mesh (or a set of spheres)
-    makes the numpy engine load compiled walks itself, so the compiled engine is taken."""
+    makes the numpy engine load compiled walks itself, so the compiled engine is taken (once
+    it is cached)."""
     from rtcli.render import prepare
+    monkeypatch.setattr(fast, "ready_to_load", lambda: True)
     small = fast.AUTO_RAYS // 2
     for name, expected in (("scenes/whitted.yaml", None), ("bench/torus100k.yaml", fast.Compiled),
                            ("bench/spheres1k.yaml", fast.Compiled)):
@@ -580,3 +585,17 @@ def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_an
         engine, _ = prepare(scene, Job(64, 48, engine="auto"), small)
         assert (engine is None) if expected is None else isinstance(engine, expected), name
         assert prepare(scene, Job(64, 48, engine="numpy"), small)[0] is None
+
+
+def test_auto_stays_on_numpy_for_a_small_job_before_the_first_compile(monkeypatch, tmp_path):
+    """Uncached, the integrator would compile for a minute where the numpy engine's walks take
+    seconds: a small mesh job stays on numpy. ready_to_load reads the cache it is given."""
+    from rtcli.render import prepare
+    monkeypatch.setattr(fast, "ready_to_load", lambda: False)
+    scene = load_scene(str(ROOT / "bench/torus100k.yaml"))
+    assert prepare(scene, Job(64, 48, engine="auto"), fast.AUTO_RAYS // 2)[0] is None
+    env = {**os.environ, "RTCLI_CACHE_DIR": str(tmp_path)}
+    ask = "from rtcli import compiled; print(compiled.ready_to_load())"
+    done = subprocess.run([sys.executable, "-c", ask], env=env, capture_output=True, text=True, cwd=ROOT)
+    assert done.stdout.strip() == "False", done.stderr
+    assert not any(tmp_path.rglob("*.nbc"))                    # asking compiled nothing

@@ -17,7 +17,7 @@ Loading numba and the cached code takes about 0.8 s, more than the numpy engine
 needs for a small image, so `auto` takes the compiled engine only from
 AUTO_RAYS primary rays up (a 1280x800 image, or 640x480 with --samples 2), and for any
 size when the numpy engine would load compiled BVH walks itself (meshes, sets of
-spheres; rtcli/render.py).
+spheres) and the integrator's code is already cached (rtcli/render.py).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from rtcli import variants
-from rtcli.compiled.loading import Load, ready
+from rtcli.compiled.loading import Load, cached, ready
 from rtcli.compiled.pack import geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
@@ -157,6 +157,15 @@ def _load() -> str | None:
 
 
 AUTO_RAYS = 1_000_000
+
+
+def ready_to_load() -> bool:
+    """Whether the compiled integrator's machine code is in numba's cache (or in memory), so that
+    starting the engine loads it rather than compiling for a minute: a forecast (loading.cached)."""
+    if _load() is not None:
+        return False
+    entry = _trace_camera()
+    return bool(entry.signatures) or cached(entry) is True
 
 
 def choose(scene, engine: str, rays: int = AUTO_RAYS, bvh: bool = True, notes=None) -> Compiled | None:
