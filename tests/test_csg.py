@@ -240,3 +240,26 @@ def test_the_numpy_engines_sort_is_precedes_order():
             k -= 1
         mine.insert(k, e)
     assert mine == order
+
+
+def test_a_cut_flush_with_a_face_cuts():
+    """A cube minus a box sharing three of its faces (a notch): no span of length 0 is left where
+    the faces coincide, so a ray through the notch misses and one from above lands on its floor,
+    the cut's face, with its normal up."""
+    from rtcli.shapes.box import Box
+    cube, notch = Child(Box((-1, -1, -1), (1, 1, 1)), None, 1), Child(Box((-1, 0, -1), (0, 1, 1)), None, 2)
+    csg = CSG("difference", [cube, notch])
+    along_z = csg.intersect(np.array([[-0.5, 0.5, 5]]), np.array([[0.0, 0, -1]]), np.array([0.0]), np.inf)
+    assert np.isinf(along_z[0][0])
+    down = np.array([[-0.5, 5.0, 0]]), np.array([[0.0, -1, 0]])
+    t, prim = csg.intersect(*down, np.array([0.0]), np.inf)
+    assert t[0] == pytest.approx(5.0) and csg.material_of(prim, 0)[0] == 2
+    shading, _ = csg.normals_at(np.array([[-0.5], [0.0], [0.0]]), prim)
+    np.testing.assert_allclose(shading[:, 0], [0, 1, 0], atol=1e-12)
+
+
+def test_solids_that_only_touch_have_an_empty_intersection():
+    """Boxes meeting at x = 0 share only a face: their intersection is nothing, not a span of length 0."""
+    from rtcli.shapes.box import Box
+    left, right = Child(Box((-1, -1, -1), (0, 1, 1)), None, 1), Child(Box((0, -1, -1), (1, 1, 1)), None, 1)
+    assert spans_of("intersection", (left, right)) == []

@@ -120,7 +120,11 @@ def combine(op, n, bt, bid, lists, top, et, ed, eo, ei, counts):
                 first_inside = not was
         after = classify(op, inside, first_inside, n)
         if after != now:
-            bt[out], bid[out], now, out = et[k], ei[k], after, out + 1
+            if out > start and bt[out - 1] == et[k]:        # a span or gap of length 0: both go
+                out -= 1
+            else:
+                bt[out], bid[out], out = et[k], ei[k], out + 1
+            now = after
     lists[2 * first + 1] = out - start
     return first + 1
 
@@ -187,8 +191,9 @@ class CSG(Shape):
                            for c in range(len(self.children))], axis=-1)
         now = classify(OPS.index(self.op), inside.sum(axis=-1), inside[..., 0], len(self.children))
         before = np.concatenate([np.zeros((o.shape[1], 1), bool), now[:, :-1]], axis=1)
-        t_in, p_in = _compact(now & ~before, t, prim)
-        t_out, p_out = _compact(~now & before, t, prim)
+        change = (now != before) & _kept(now != before, t)
+        t_in, p_in = _compact(change & now, t, prim)
+        t_out, p_out = _compact(change & ~now, t, prim)
         return t_in, p_in, t_out, p_out
 
     def hits(self, o, d, t_min, t_max):
@@ -253,6 +258,24 @@ class CSG(Shape):
                                                            np.max([b[1] for b in finite], axis=0))
         return None if not finite else (np.max([b[0] for b in finite], axis=0),
                                         np.min([b[1] for b in finite], axis=0))
+
+
+def _kept(change, t):
+    """Which changes of the result stay when spans and gaps of length 0 go (where solids share a
+    face): of the changes at one t (a run of equal t along the sorted row) none when there is an
+    even number, else the last, as `combine` cancels each with the one before it at the same t."""
+    count = t.shape[1]
+    pos = np.broadcast_to(np.arange(count), t.shape)
+    starts = np.ones(t.shape, dtype=bool)
+    starts[:, 1:] = t[:, 1:] != t[:, :-1]
+    ends = np.ones(t.shape, dtype=bool)
+    ends[:, :-1] = t[:, :-1] != t[:, 1:]
+    lo = np.maximum.accumulate(np.where(starts, pos, 0), axis=1)                      # each run's first
+    hi = np.minimum.accumulate(np.where(ends, pos, count)[:, ::-1], axis=1)[:, ::-1]  # and last
+    done = np.cumsum(change, axis=1)
+    earlier = np.take_along_axis(done, lo, axis=1) - np.take_along_axis(change, lo, axis=1)
+    in_run = np.take_along_axis(done, hi, axis=1) - earlier
+    return (done - earlier == in_run) & (in_run % 2 == 1)
 
 
 def _compact(mask, t, prim):
