@@ -74,7 +74,7 @@ def run(items: list[Item], folder: str | None, load: Callable, render: Callable)
     """
     from rtcli.outputs import check_outputs
     from rtcli.writer import Staged
-    made = _make_folder(folder)
+    made = make_folder(folder)
     done, inputs, outputs = [], [], [(item.output, False) for item in items]
     try:
         with Staged() as staged:
@@ -89,12 +89,12 @@ def run(items: list[Item], folder: str | None, load: Callable, render: Callable)
             staged.commit()
     except BaseException:
         if made:
-            _remove_folder(folder)
+            remove_folder(folder)
         raise
     return done
 
 
-def _make_folder(folder: str | None) -> bool:
+def make_folder(folder: str | None) -> bool:
     """Create the output folder when it does not exist yet (its parent must); whether it was made."""
     if folder is None or os.path.isdir(folder):
         return False
@@ -105,7 +105,8 @@ def _make_folder(folder: str | None) -> bool:
     return True
 
 
-def _remove_folder(folder: str) -> None:
+def remove_folder(folder: str) -> None:
+    """Remove the folder if it is empty."""
     try:
         os.rmdir(folder)
     except OSError:

@@ -78,7 +78,8 @@ def _box(bounds) -> str:
 
 def warnings(scene: Scene, remarks: Remarks) -> list[Remark]:
     """Every warning about the scene, in the order of the checks above."""
-    found = list(dict.fromkeys(remarks.colors))            # a color read twice (an alias) once
+    colors = list(dict.fromkeys(remarks.colors))           # a color read twice (an alias) once
+    found = _limited(colors, colors[LISTED].where if len(colors) > LISTED else "", "colors that look like 0-255 values")
     if not scene.lights:
         found.append(Remark(remarks.lights_key, "no lights: only ambient light and emission show "
                                                 "(a light is {position: [x, y, z]})"))

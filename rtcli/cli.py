@@ -281,15 +281,29 @@ def _render_frames(scene_file: str, output, frame_range, frame, movie, skip_exis
                    changes: dict, workers, bar: bool, stats) -> None:
     """An animation's frames to files or movies (frames.py), each file written as its frame is done;
     `stats`: None, "line" or "json"."""
+    from rtcli import batch
+    from rtcli import frames as animation
+    start = time.perf_counter()
+    loaded = animation.load(scene_file, None, keep=where is not None)
+    seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
+    folder = os.path.dirname(os.path.abspath(next(iter(seq.paths.values())))) if seq.paths else None
+    made = batch.make_folder(folder)                     # a frame pattern's folder (its parent must exist)
+    try:
+        _check_outputs([(p, False) for p in seq.paths.values()] + [(m, "movie") for m in seq.movies], loaded.inputs)
+        _render_sequence(loaded, seq, scene_file, changes, workers, bar, stats, where, job, skip_existing, start)
+    except BaseException:
+        if made:
+            batch.remove_folder(folder)                  # only when empty: frames written stay
+        raise
+
+
+def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: bool, stats, where, job: dict,
+                     skip_existing: bool, start: float) -> None:
     import json
 
     from rtcli import frames as animation
     from rtcli.results import RenderStats
-    start = time.perf_counter()
-    loaded = animation.load(scene_file, None, keep=where is not None)
     scene = loaded.scene
-    seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
-    _check_outputs([(p, False) for p in seq.paths.values()] + [(m, "movie") for m in seq.movies], loaded.inputs)
     animation.apply(scene, changes)            # the other frames are checked as written, then changed alike
     size = job.pop("width"), job.pop("height"), job.pop("block_size")
     job = _job(scene, *size, **job)
@@ -310,19 +324,22 @@ def _render_frames(scene_file: str, output, frame_range, frame, movie, skip_exis
 
 
 def _watch(item, load, render_one, stats: bool, as_json: bool) -> None:
-    """render --watch: the scene to its image now and after every change, until Ctrl-C."""
+    """render --watch: the scene to its image now and after every change, until Ctrl-C. With
+    --json, stdout holds only the JSON lines (the watch's own lines go to stderr)."""
     from rtcli import batch
+    from rtcli.outputs import check_file_output
     from rtcli.watch import watch
+    check_file_output(item.output, [item.scene])        # the scene as its own output: refused at once
 
     def once() -> None:
         start = time.perf_counter()
         image = render_one(load(item.scene), os.path.basename(item.scene), item.output)
         seconds = time.perf_counter() - start
         click.echo(f"{time.strftime('%H:%M:%S')} rendered {shown(item.output)} "
-                   f"({image.shape[1]}x{image.shape[0]}) in {seconds:.2f} s")
+                   f"({image.shape[1]}x{image.shape[0]}) in {seconds:.2f} s", err=as_json)
         for line in batch.stats_lines([(item, image.stats, seconds)], as_json, False) if stats else ():
             click.echo(line)
-    click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends")
+    click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends", err=as_json)
     watch(item.scene, once, lambda line: click.echo(line, err=True))
 
 

@@ -151,6 +151,9 @@ def sequence(animation: Animation, scene_file: str, output: str | None, frames: 
         raise RtcliError("--frames and --frame: give one")
     if movie:
         movie_format(movie)
+    for name in (m for m in (output, movie) if is_movie(m) and PATTERN.fullmatch(m)):
+        raise RtcliError(f"-o {shown(name)}: a movie is one file, so its name takes no frame number; "
+                         "for one image a frame, name them .png (frame_%04d.png)")
     wanted = [frame] if frame else _range(frames, animation, scene_file)
     movies = [m for m in (output if is_movie(output) else None, movie) if m]
     if output and not is_movie(output):

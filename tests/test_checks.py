@@ -91,6 +91,15 @@ def test_a_light_color_and_the_background_are_checked_too(validate):
                                                                 "s.yaml:4:13: background"]
 
 
+def test_many_0_255_colors_are_listed_up_to_a_count(validate):
+    """25 spheres with a byte color: the first 20 warnings, then one line counting the other 5."""
+    spheres = "".join(f"  - {{sphere: {{center: [{k}, 0, -5]}}, material: {{diffuse: [255, 0, 0]}}}}\n"
+                      for k in range(25))
+    found = warnings_of(validate(CAM + LIGHT + "objects:\n" + spheres))
+    assert len(found) == 21 and found[-1].startswith("s.yaml:25:")
+    assert found[-1].endswith("warning: 5 more colors that look like 0-255 values (the first 20 are above)")
+
+
 # --- lights, camera, objects ---
 def test_no_lights(validate):
     assert warnings_of(validate(CAM + "objects: [{sphere: {}}]\n")) == [

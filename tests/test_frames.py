@@ -96,6 +96,9 @@ def test_validate_checks_every_frame(run):
                                           "not one of .apng, .gif"),
     (["-o", "orbit.yaml", "--frame", "2"], "orbit.yaml: is an input of this run; it will not be overwritten "
                                           "(choose another output name)"),
+    (["--frames", "1-2", "-o", "g_%02d.gif"], "-o g_%02d.gif: a movie is one file, so its name takes no frame "
+                                              "number; for one image a frame, name them .png (frame_%04d.png)"),
+    (["--frames", "1-2", "-o", "new/f_%02d.png", "--frame", "1"], "--frames and --frame: give one"),
 ])
 def test_frame_option_errors_are_one_line_and_write_nothing(run, tmp_path, args, message):
     result = run("render", "orbit.yaml", *args, *SMALL)
@@ -206,3 +209,12 @@ def test_stats_of_a_sequence_count_the_frames_rendered(run, tmp_path):
     assert (json.loads(result.output)["frames"], json.loads(result.output)["primary"]) == ([3], 1200)
     result = run("render", "orbit.yaml", "--frames", "2-4", "-o", "f%d.png", "--stats", *SMALL)
     assert result.output.startswith("rays: 3600 primary, ") and result.output.count("\n") == 1
+
+
+def test_a_frame_pattern_makes_its_folder(run, tmp_path):
+    """-o out/frame_%04d.png in a folder that does not exist yet makes it (its parent must exist)."""
+    result = run("render", "orbit.yaml", "--frames", "1-2", "-o", "out/f_%02d.png", *SMALL)
+    assert result.exit_code == 0, result.output
+    assert sorted(os.listdir(tmp_path / "out")) == ["f_01.png", "f_02.png"]
+    result = run("render", "orbit.yaml", "--frames", "1-2", "-o", "no/deeper/f_%02d.png", *SMALL)
+    assert result.exit_code == 2 and "cannot create the output folder" in result.output

@@ -260,3 +260,28 @@ def test_watch_renders_one_image_here(tmp_path, monkeypatch):
                            (["--skip-existing"], "give --frame N"), (["--local-cluster", "2"], "no cluster option")):
         result = CliRunner().invoke(main, ["render", "a.yaml", "--watch", *extra])
         assert result.exit_code == 2 and message in result.output, (extra, result.output)
+
+
+def test_the_scene_as_its_own_output_is_refused_before_watching(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.yaml").write_text(SCENE % 1)
+    result = CliRunner().invoke(main, ["render", "s.yaml", "--watch", "-o", "s.yaml"])
+    assert result.exit_code == 2 and "is an input of this run" in result.output
+    assert (tmp_path / "s.yaml").read_text() == SCENE % 1
+
+
+def test_watch_with_json_keeps_stdout_to_the_json_lines(tmp_path, monkeypatch):
+    """--stats --json: one JSON object per render on stdout; the watch's own lines on stderr."""
+    import json
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.yaml").write_text(SCENE % 1)
+    (tmp_path / "mat.yaml").write_text(PAINT % "[1, 0, 0]")
+
+    def once(scene, render, error, poll=None):
+        render()
+        raise KeyboardInterrupt
+    monkeypatch.setattr(watching, "watch", once)
+    result = CliRunner().invoke(main, ["render", "s.yaml", "--watch", "--stats", "--json"])
+    assert result.exit_code == 130
+    assert json.loads(result.stdout)["primary"] == 32 * 24
+    assert "watching s.yaml" in result.stderr and " rendered s.png " in result.stderr
