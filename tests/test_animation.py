@@ -231,6 +231,8 @@ def test_a_key_out_of_range_is_blamed_at_the_key_and_a_value_between_keys_at_its
     ("{clock: [1, 1]}", "a.yaml:1:20: animation.clock: the end must come after the start, got [1, 1]"),
     ("{frames: 4, fps: -1}", "a.yaml:1:29: animation.fps: must be > 0, got -1"),
     ("{frames: 4, rate: 2}", "a.yaml:1:24: animation.rate: unknown key (did you mean 'frames'?); allowed here: fps, frames"),
+    ("{frame: 3}", "a.yaml:1:13: animation.frame: unknown key (did you mean 'frames'?); allowed here: fps, frames, "
+                   "clock"),
 ])
 def test_animation_section_errors(tmp_path, section, message):
     assert error_of(tmp_path, f"animation: {section}\ncamera: {{eye: [0, 0, 5], look_at: [0, 0, 0]}}\n") == message

@@ -125,6 +125,10 @@ NOTES = {
     "angle": (obj("sphere: {}\n    transform: [{rotate: {axis: [0, 1, 0], angle: 30}}]"),
               "scene.yaml:4:44: objects[0].transform[0].rotate.angle: unknown key (the notes' angle is 'degrees' "
               "in rtcli); allowed here: axis, degrees"),
+    #            "    transform: [{rotate: {angle: 30}}]": 'angle' at 27, before the missing axis too
+    "angle_alone": (obj("sphere: {}\n    transform: [{rotate: {angle: 30}}]"),
+                    "scene.yaml:4:27: objects[0].transform[0].rotate.angle: unknown key (the notes' angle is "
+                    "'degrees' in rtcli); allowed here: axis, degrees"),
 }
 
 

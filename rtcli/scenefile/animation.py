@@ -196,6 +196,9 @@ def _items(node, key: str):
 def _clock(p: Params) -> Clock:
     """The `animation:` section: fps (default 24) and exactly one of frames and clock."""
     fps = p.number("fps", 24.0, positive=True)
+    if not (p.has("frames") or p.has("clock")):
+        p.known("frames", "clock")
+        p.check_unused()                                 # a misspelt frames or clock says so
     if p.has("frames") == p.has("clock"):
         raise p.error(None, "give the frame count (frames: 120) or the clock range (clock: [0, 5]), "
                             "not both" if p.has("frames") else "needs frames (a count) or clock ([start, end] in s)")

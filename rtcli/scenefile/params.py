@@ -133,6 +133,9 @@ class Params:
                 for given in self.node:
                     if given not in self.read and _misspells(given, key):
                         raise self.unknown_key(given, key)
+                for given in self.node:                  # the notes' name of another key declared here
+                    if given not in self.read and isinstance(given, str) and NOTES_NAMES.get(given) in self.read:
+                        raise self.unknown_key(given)
                 raise SceneError(self.node.where, self.key_path(key), "missing required key")
             return default
         return self.node[key]
