@@ -397,6 +397,7 @@ def _suffix(bind: dict) -> str:
 
 
 def _numba(f, how: Kernel):
+    _start_numba()
     from numba import njit
     where = cache_location()
     options = dict(cache=where.enabled, error_model="numpy")
@@ -406,6 +407,28 @@ def _numba(f, how: Kernel):
         options["inline"] = "always"
     with where.applied():
         return njit(**options)(f)
+
+
+_started = False
+
+
+def _start_numba() -> None:
+    """Import numba's array functions with scipy's BLAS hidden, once. numba looks for a BLAS (for
+    np.dot in compiled code) when that module is first imported, which imports scipy.linalg,
+    about 0.1-0.2 s; rtcli's compiled code needs none, so numba goes on without it."""
+    global _started
+    if _started:
+        return
+    name = "scipy.linalg.cython_blas"
+    hidden = name not in sys.modules
+    if hidden:
+        sys.modules[name] = None                         # the import fails at once
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        if hidden and sys.modules.get(name, 0) is None:
+            del sys.modules[name]
+    _started = True
 
 
 INEXACT = ("arccos", "arcsin", "arctan2", "cbrt")        # numpy may take these (and x ** y) from SVML

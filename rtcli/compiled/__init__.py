@@ -22,10 +22,8 @@ spheres) and the integrator's code is already cached (rtcli/render.py).
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import os
-import sys
 import time
 from pathlib import Path
 
@@ -51,9 +49,8 @@ class Compiled:
         self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh)
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
         nowhere, none = Camera(*np.zeros((4, 3))), np.zeros(0)
-        with _no_blas_lookup():                                        # no ray: just the machine code
-            self.load = ready([_trace_camera()], lambda: self.trace_pixels(nowhere, none, none, 1, 1, Stats()),
-                              "the render engine", "about a minute", notes, start)
+        self.load = ready([_trace_camera()], lambda: self.trace_pixels(nowhere, none, none, 1, 1, Stats()),
+                          "the render engine", "about a minute", notes, start)     # no ray: just the machine code
 
     def trace_pixels(self, cam, x: np.ndarray, y: np.ndarray, nc: int, nr: int, stats: Stats) -> np.ndarray:
         """Colors (n, 3) of the camera's rays through pixel coordinates (x, y)."""
@@ -67,22 +64,6 @@ class Compiled:
 def _trace_camera():
     from rtcli.compiled.integrator import trace_camera
     return variants.compiled(trace_camera)
-
-
-@contextlib.contextmanager
-def _no_blas_lookup():
-    """numba imports scipy.linalg when it starts, ~0.2 s, to find a BLAS for np.dot in compiled code;
-    the integrator needs none, so the module numba looks for is hidden meanwhile."""
-    name = "scipy.linalg.cython_blas"
-    if name in sys.modules:
-        yield
-        return
-    sys.modules[name] = None                         # import fails at once: numba goes on without BLAS
-    try:
-        yield
-    finally:
-        if sys.modules.get(name, 0) is None:
-            del sys.modules[name]
 
 
 PACKAGE = Path(variants.PACKAGE_DIR)
@@ -149,8 +130,7 @@ def _load() -> str | None:
         return "numba is not installed (pip install -e '.[fast]' from rtcli's folder)"
     drop_stale_cache()
     try:
-        with _no_blas_lookup():
-            import rtcli.compiled.integrator  # noqa: F401
+        import rtcli.compiled.integrator  # noqa: F401
     except ImportError as e:
         return f"numba cannot be loaded ({e})"
     return None
