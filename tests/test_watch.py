@@ -156,8 +156,9 @@ def test_watch_takes_one_scene(tmp_path, monkeypatch):
     assert (result.exit_code, result.output) == (2, "error: --watch renders one scene file\n")
 
 
-def test_watch_with_view_writes_the_view(tmp_path, monkeypatch):
-    """--watch --view KIND writes NAME.KIND.png at every change (one render here, then Ctrl-C)."""
+@pytest.fixture
+def one_render(tmp_path, monkeypatch):
+    """s.yaml in the current folder, and a watch that renders once, then is interrupted."""
     monkeypatch.chdir(tmp_path)
     (tmp_path / "s.yaml").write_text(SCENE % 1)
     (tmp_path / "mat.yaml").write_text(PAINT % "[1, 0, 0]")
@@ -166,6 +167,10 @@ def test_watch_with_view_writes_the_view(tmp_path, monkeypatch):
         render()
         raise KeyboardInterrupt
     monkeypatch.setattr(watching, "watch", once)
+
+
+def test_watch_with_view_writes_the_view(tmp_path, one_render):
+    """--watch --view KIND writes NAME.KIND.png at every change (one render here, then Ctrl-C)."""
     result = CliRunner().invoke(main, ["render", "s.yaml", "--watch", "--view", "normal"])
     assert result.exit_code == 130 and " rendered s.normal.png (32x24) in " in result.output
     assert sorted(os.listdir(tmp_path)) == ["mat.yaml", "s.normal.png", "s.yaml"]
@@ -270,17 +275,9 @@ def test_the_scene_as_its_own_output_is_refused_before_watching(tmp_path, monkey
     assert (tmp_path / "s.yaml").read_text() == SCENE % 1
 
 
-def test_watch_with_json_keeps_stdout_to_the_json_lines(tmp_path, monkeypatch):
+def test_watch_with_json_keeps_stdout_to_the_json_lines(one_render):
     """--stats --json: one JSON object per render on stdout; the watch's own lines on stderr."""
     import json
-    monkeypatch.chdir(tmp_path)
-    (tmp_path / "s.yaml").write_text(SCENE % 1)
-    (tmp_path / "mat.yaml").write_text(PAINT % "[1, 0, 0]")
-
-    def once(scene, render, error, poll=None):
-        render()
-        raise KeyboardInterrupt
-    monkeypatch.setattr(watching, "watch", once)
     result = CliRunner().invoke(main, ["render", "s.yaml", "--watch", "--stats", "--json"])
     assert result.exit_code == 130
     assert json.loads(result.stdout)["primary"] == 32 * 24
