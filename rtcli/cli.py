@@ -13,7 +13,6 @@ import os
 import signal
 import sys
 import threading
-import time
 
 import click
 
@@ -109,16 +108,6 @@ def _check_outputs(outputs, inputs) -> None:
     check_outputs(outputs, inputs)
 
 
-def _progress(enabled: bool, label: str):
-    if not enabled:
-        return None
-
-    def show(done, total):
-        bar = "#" * (30 * done // total)
-        click.echo(f"\r{label} [{bar:<30}] {100 * done // total:3d}%", err=True, nl=done == total)
-    return show
-
-
 def _cluster_options(command):
     """--cluster, --cluster-file and --local-cluster (README.md, Clusters)."""
     for option in reversed((
@@ -141,15 +130,6 @@ def _cluster(address, file, local):
     from rtcli.cluster import target
     from rtcli.frames import Reach
     return Reach(target(address, file, local))
-
-
-def _size(model, width, height) -> tuple[int, int]:
-    """The image size of a scene's model (api.image_size with the options' names), its note printed."""
-    from rtcli import api
-    w, h, note = api.image_size(model, width, height, ("--width", "--height"))
-    if note:
-        click.echo(f"note: {note}", err=True)
-    return w, h
 
 
 @main.command()
@@ -193,7 +173,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
            cluster, cluster_file, local_cluster, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
-    from rtcli import api, batch
+    from rtcli import api, batch, runs
     from rtcli import frames as animation
     from rtcli.movie import is_movie
     if as_json and not stats:
@@ -225,7 +205,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
             job = dict(width=width, height=height, block_size=block_size, tile=tile, gamma=gamma, engine=engine,
                        bvh=not no_bvh)
             shown_stats = ("json" if as_json else "line") if stats else None
-            return _render_frames(scene_files[0], output, frame_range, frame, movie, skip_existing, where, job,
+            return runs.render_frames(scene_files[0], output, frame_range, frame, movie, skip_existing, where, job,
                                   animation.overrides(samples, max_depth), workers, bar, shown_stats)
         items, folder = batch.plan(list(scene_files), output, f".{view}.png" if view else ".png")
         if skip_existing:
@@ -239,117 +219,24 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
 
         def render_one(scene, label, out=None):
             api.image_size(scene.model, width, height, ("--width", "--height"))      # the options' names in errors
-            show = _progress(bar, one_line(label))
+            show = runs.progress_bar(bar, one_line(label))
             if view:
-                image = _view(scene, view, width, height, tile, label if folder is not None else None)
+                image = runs.view(scene, view, width, height, tile, label if folder is not None else None)
                 if out is not None:                               # --watch writes each view itself
                     image.save(out)
                 return image
             if where is not None:
-                return _on_cluster(current["loaded"], scene, where, dict(samples=samples, max_depth=max_depth),
+                return runs.on_cluster(current["loaded"], scene, where, dict(samples=samples, max_depth=max_depth),
                                    width, height, block_size, tile=tile, gamma=gamma, engine=engine,
                                    bvh=not no_bvh, progress=show)
             return api.render(scene, width=width, height=height, engine=engine, workers=workers,
                               block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh, output=out,
                               progress=show, notes=note)
         if watch:
-            return _watch(items[0], load, render_one, stats, as_json)
+            return runs.watch_scene(items[0], load, render_one, stats, as_json)
         done = batch.run(items, folder, load, render_one) if items else []
     for line in batch.stats_lines(done, as_json, folder is not None) if stats else ():
         click.echo(line)
-
-
-def _job(model, width, height, block_size, **kw):
-    from rtcli.render import Job
-    return Job(*_size(model, width, height), block_size, **kw)
-
-
-def _on_cluster(loaded, scene, where, changes: dict, width, height, block_size, progress=None, **kw):
-    """The still (frames.render_image) of `loaded` traced on the cluster, as api.render returns it."""
-    from rtcli.frames import overrides, render_image
-    from rtcli.results import ImageArray, RenderStats
-    job = _job(scene.model, width, height, block_size, **kw)
-    start = time.perf_counter()
-    pixels, counts = render_image(loaded, job, 1, progress, where, overrides(**changes))
-    s = scene.model.settings
-    stats = RenderStats(job.width, job.height, 1 if job.signature else s.samples, counts.engine, counts.primary,
-                        counts.shadow, counts.reflected, counts.refracted, time.perf_counter() - start)
-    return ImageArray(pixels, stats, scene.inputs)
-
-
-def _render_frames(scene_file: str, output, frame_range, frame, movie, skip_existing: bool, where, job: dict,
-                   changes: dict, workers, bar: bool, stats) -> None:
-    """An animation's frames to files or movies (frames.py), each file written as its frame is done;
-    `stats`: None, "line" or "json"."""
-    from rtcli import batch
-    from rtcli import frames as animation
-    start = time.perf_counter()
-    loaded = animation.load(scene_file, None, keep=where is not None)
-    seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
-    folder = os.path.dirname(os.path.abspath(next(iter(seq.paths.values())))) if seq.paths else None
-    made = batch.make_folder(folder)                     # a frame pattern's folder (its parent must exist)
-    try:
-        _check_outputs([(p, False) for p in seq.paths.values()] + [(m, "movie") for m in seq.movies], loaded.inputs)
-        _render_sequence(loaded, seq, scene_file, changes, workers, bar, stats, where, job, skip_existing, start)
-    except BaseException:
-        if made:
-            batch.remove_folder(folder)                  # only when empty: frames written stay
-        raise
-
-
-def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: bool, stats, where, job: dict,
-                     skip_existing: bool, start: float) -> None:
-    import json
-
-    from rtcli import frames as animation
-    from rtcli.results import RenderStats
-    scene = loaded.scene
-    animation.apply(scene, changes)            # the other frames are checked as written, then changed alike
-    size = job.pop("width"), job.pop("height"), job.pop("block_size")
-    job = _job(scene, *size, **job)
-    show = _progress(bar, one_line(os.path.basename(scene_file)))
-    todo, rendering = animation.to_render(seq, skip_existing), time.perf_counter()
-    counts = animation.render_sequence(loaded, seq, job, workers or os.cpu_count() or 1, changes, skip_existing,
-                                       show, where)
-    if not stats:
-        return
-    done = RenderStats(job.width, job.height, scene.settings.samples, counts.engine or "none", counts.primary,
-                       counts.shadow, counts.reflected, counts.refracted, time.perf_counter() - rendering)
-    seconds = time.perf_counter() - start
-    if stats == "json":
-        click.echo(json.dumps({"scene": scene_file, "frames": todo, **done.as_dict(),
-                               "wall_seconds": round(seconds, 6)}))
-    else:
-        click.echo(done.line(seconds))
-
-
-def _watch(item, load, render_one, stats: bool, as_json: bool) -> None:
-    """render --watch: the scene to its image now and after every change, until Ctrl-C. With
-    --json, stdout holds only the JSON lines (the watch's own lines go to stderr)."""
-    from rtcli import batch
-    from rtcli.outputs import check_file_output
-    from rtcli.watch import watch
-    check_file_output(item.output, [item.scene])        # the scene as its own output: refused at once
-
-    def once() -> None:
-        start = time.perf_counter()
-        image = render_one(load(item.scene), os.path.basename(item.scene), item.output)
-        seconds = time.perf_counter() - start
-        click.echo(f"{time.strftime('%H:%M:%S')} rendered {shown(item.output)} "
-                   f"({image.shape[1]}x{image.shape[0]}) in {seconds:.2f} s", err=as_json)
-        for line in batch.stats_lines([(item, image.stats, seconds)], as_json, False) if stats else ():
-            click.echo(line)
-    click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends", err=as_json)
-    watch(item.scene, once, lambda line: click.echo(line, err=True))
-
-
-def _view(scene, kind: str, width, height, tile: int, label: str | None):
-    """A debug view's picture (rtcli/views.py), its summary line printed."""
-    from rtcli.results import ImageArray
-    from rtcli.views import summary, view
-    data = view(scene, kind, width=width, height=height, tile=tile)
-    click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
-    return ImageArray(data.to_8bit(), inputs=scene.inputs)
 
 
 @main.command()
@@ -371,7 +258,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
     import numpy as np
 
-    from rtcli import api
+    from rtcli import api, runs
     from rtcli.writer import signature_colors, write_images
     where = _cluster(cluster, cluster_file, local_cluster)
     loaded, scene = _load(scene_file, frame, keep=where is not None)
@@ -383,7 +270,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     else:
         api.check_ids(scene)
         with where:
-            ids = _on_cluster(loaded, scene, where, dict(samples=None, max_depth=None), width, height, block_size,
+            ids = runs.on_cluster(loaded, scene, where, dict(samples=None, max_depth=None), width, height, block_size,
                               signature=True)
     write_images([(out, signature_colors(ids))] + ([(ids_out, np.asarray(ids))] if ids_out else []))
     if legend:

@@ -1,0 +1,126 @@
+"""How `rtcli render` (and `signature`) carry out what the options ask (README.md, Commands):
+the image size with its note, the progress bar, an animation's frames, a still traced on a
+cluster, a watch, a debug view. cli.py parses the options and calls these.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+import click
+
+from rtcli.errors import one_line, shown
+from rtcli.outputs import check_outputs
+
+
+def size(model, width, height) -> tuple[int, int]:
+    """The image size of a scene's model (api.image_size with the options' names), its note printed."""
+    from rtcli import api
+    w, h, note = api.image_size(model, width, height, ("--width", "--height"))
+    if note:
+        click.echo(f"note: {note}", err=True)
+    return w, h
+
+
+def progress_bar(enabled: bool, label: str):
+    if not enabled:
+        return None
+
+    def show(done, total):
+        bar = "#" * (30 * done // total)
+        click.echo(f"\r{label} [{bar:<30}] {100 * done // total:3d}%", err=True, nl=done == total)
+    return show
+
+
+def make_job(model, width, height, block_size, **kw):
+    from rtcli.render import Job
+    return Job(*size(model, width, height), block_size, **kw)
+
+
+def on_cluster(loaded, scene, where, changes: dict, width, height, block_size, progress=None, **kw):
+    """The still (frames.render_image) of `loaded` traced on the cluster, as api.render returns it."""
+    from rtcli.frames import overrides, render_image
+    from rtcli.results import ImageArray, RenderStats
+    job = make_job(scene.model, width, height, block_size, **kw)
+    start = time.perf_counter()
+    pixels, counts = render_image(loaded, job, 1, progress, where, overrides(**changes))
+    s = scene.model.settings
+    stats = RenderStats(job.width, job.height, 1 if job.signature else s.samples, counts.engine, counts.primary,
+                        counts.shadow, counts.reflected, counts.refracted, time.perf_counter() - start)
+    return ImageArray(pixels, stats, scene.inputs)
+
+
+def render_frames(scene_file: str, output, frame_range, frame, movie, skip_existing: bool, where, job: dict,
+                   changes: dict, workers, bar: bool, stats) -> None:
+    """An animation's frames to files or movies (frames.py), each file written as its frame is done;
+    `stats`: None, "line" or "json"."""
+    from rtcli import batch
+    from rtcli import frames as animation
+    start = time.perf_counter()
+    loaded = animation.load(scene_file, None, keep=where is not None)
+    seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
+    folder = os.path.dirname(os.path.abspath(next(iter(seq.paths.values())))) if seq.paths else None
+    made = batch.make_folder(folder)                     # a frame pattern's folder (its parent must exist)
+    try:
+        check_outputs([(p, False) for p in seq.paths.values()] + [(m, "movie") for m in seq.movies], loaded.inputs)
+        _render_sequence(loaded, seq, scene_file, changes, workers, bar, stats, where, job, skip_existing, start)
+    except BaseException:
+        if made:
+            batch.remove_folder(folder)                  # only when empty: frames written stay
+        raise
+
+
+def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: bool, stats, where, job: dict,
+                     skip_existing: bool, start: float) -> None:
+    import json
+
+    from rtcli import frames as animation
+    from rtcli.results import RenderStats
+    scene = loaded.scene
+    animation.apply(scene, changes)            # the other frames are checked as written, then changed alike
+    size = job.pop("width"), job.pop("height"), job.pop("block_size")
+    job = make_job(scene, *size, **job)
+    show = progress_bar(bar, one_line(os.path.basename(scene_file)))
+    todo, rendering = animation.to_render(seq, skip_existing), time.perf_counter()
+    counts = animation.render_sequence(loaded, seq, job, workers or os.cpu_count() or 1, changes, skip_existing,
+                                       show, where)
+    if not stats:
+        return
+    done = RenderStats(job.width, job.height, scene.settings.samples, counts.engine or "none", counts.primary,
+                       counts.shadow, counts.reflected, counts.refracted, time.perf_counter() - rendering)
+    seconds = time.perf_counter() - start
+    if stats == "json":
+        click.echo(json.dumps({"scene": scene_file, "frames": todo, **done.as_dict(),
+                               "wall_seconds": round(seconds, 6)}))
+    else:
+        click.echo(done.line(seconds))
+
+
+def watch_scene(item, load, render_one, stats: bool, as_json: bool) -> None:
+    """render --watch: the scene to its image now and after every change, until Ctrl-C. With
+    --json, stdout holds only the JSON lines (the watch's own lines go to stderr)."""
+    from rtcli import batch
+    from rtcli.outputs import check_file_output
+    from rtcli.watch import watch
+    check_file_output(item.output, [item.scene])        # the scene as its own output: refused at once
+
+    def once() -> None:
+        start = time.perf_counter()
+        image = render_one(load(item.scene), os.path.basename(item.scene), item.output)
+        seconds = time.perf_counter() - start
+        click.echo(f"{time.strftime('%H:%M:%S')} rendered {shown(item.output)} "
+                   f"({image.shape[1]}x{image.shape[0]}) in {seconds:.2f} s", err=as_json)
+        for line in batch.stats_lines([(item, image.stats, seconds)], as_json, False) if stats else ():
+            click.echo(line)
+    click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends", err=as_json)
+    watch(item.scene, once, lambda line: click.echo(line, err=True))
+
+
+def view(scene, kind: str, width, height, tile: int, label: str | None):
+    """A debug view's picture (rtcli/views.py), its summary line printed."""
+    from rtcli.results import ImageArray
+    from rtcli.views import summary, view
+    data = view(scene, kind, width=width, height=height, tile=tile)
+    click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
+    return ImageArray(data.to_8bit(), inputs=scene.inputs)
