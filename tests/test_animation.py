@@ -196,6 +196,11 @@ HEAD = "animation: {fps: 4, frames: 8}\nobjects: [{sphere: {}}]\n"
      "a.yaml:3:16: camera.eye.key: unknown key (did you mean 'keys'?); allowed here: keys, ease"),
     ("{eye: {keys: {}}, look_at: [0, 0, 0]}",
      "a.yaml:3:22: camera.eye.keys: needs at least one keyframe, `time: value`"),
+    ("{eye: [0, 0, 5], look_at: {x: 0, y: 1, z: 0}}",              # a vector written as a mapping
+     "a.yaml:3:35: camera.look_at: must be a vector [x, y, z], or keyframes {keys: {time: value, ...}}; "
+     "got a mapping without keys"),
+    ("{eye: {keys: {true: [0, 0, 5]}}, look_at: [0, 0, 0]}",        # YAML's spelling of the key
+     "a.yaml:3:23: camera.eye.keys.true: a keyframe's time must be a number of seconds"),
 ])
 def test_keyframe_errors_are_located(tmp_path, camera, message):
     assert error_of(tmp_path, HEAD + f"camera: {camera}\n") == message

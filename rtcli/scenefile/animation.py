@@ -19,6 +19,7 @@ before it, in which process, or on which machine.
 from __future__ import annotations
 
 import bisect
+import difflib
 import gc
 import math
 from dataclasses import dataclass
@@ -44,6 +45,8 @@ EASES = {                                   # s in [0, 1] between two keys -> th
 
 # what a keyframed value is: how its keys are read
 VECTOR, NUMBER, COLOR, COEFFICIENT, SCALE = "vector", "number", "color", "coefficient", "scale"
+WRITTEN = {VECTOR: "a vector [x, y, z]", NUMBER: "a number", COLOR: "a color [r, g, b]",
+           COEFFICIENT: "a number or a color [r, g, b]", SCALE: "a number or a vector [x, y, z]"}
 CAMERA = {"eye": VECTOR, "look_at": VECTOR, "up": VECTOR, "fov": NUMBER}
 LIGHT = {"position": VECTOR, "color": COLOR}
 MATERIAL = {"ambient": COEFFICIENT, "diffuse": COEFFICIENT, "specular": COEFFICIENT, "reflection": COEFFICIENT,
@@ -71,6 +74,10 @@ class Track:
     def __init__(self, node: MapNode, label: str, kind: str, clock: Clock):
         p = Params(node, label)
         self.label, self.where = label, node.where
+        near = difflib.get_close_matches("keys", [str(k) for k in node], n=1) or "ease" in node
+        if "keys" not in node and not near:          # a mapping where a plain value was meant
+            raise SceneError(node.where, label, f"must be {WRITTEN[kind]}, or keyframes {{keys: {{time: value, "
+                             f"...}}}}; got a mapping without keys")
         p.known("keys", "ease")
         p.check_unused()
         self.ease = EASES[p.choice("ease", tuple(EASES), "linear")]

@@ -257,6 +257,8 @@ class Builder:
             return value
         if not isinstance(value, (str, int, float, bool)):
             raise SceneError(unpack(self.file, pos), "", "keys must be plain names")
+        if type(value) is bool:
+            return "true" if value else "false"                  # as YAML writes them, not Python
         return value if type(value) is str else sys.intern(str(value))
 
     def finish(self, frame: _Frame):
