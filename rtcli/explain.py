@@ -1,4 +1,4 @@
-"""Why a pixel has its color: the ray tree of one pixel, term by term (docs/explain.md).
+"""Why a pixel has its color: the ray tree of one pixel, term by term (docs/debugging.md).
 
 `explain` traces the pixel's rays with the numpy engine (rtcli/wavefront/trace.py) and a
 Recorder, which the engine shows every quantity as it computes it: the hit, the surface, the

@@ -1,4 +1,4 @@
-"""The ray tree of `rtcli explain` as text (docs/explain.md): one ray a block, its terms under it,
+"""The ray tree of `rtcli explain` as text (docs/debugging.md): one ray a block, its terms under it,
 its secondary rays nested, and the sum at the foot of every block.
 
 `style(text, role)` colors a piece by its role (ray, miss, term, sum, note); the command line
@@ -7,9 +7,12 @@ passes click.style's colors, which it shows only on a terminal.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from rtcli.explain import Explanation, LightTerm, RayNode
+if TYPE_CHECKING:                                   # explain.py imports this module to print itself
+    from rtcli.explain import Explanation, LightTerm, RayNode
 
 BRANCH, PIPE, INDENT = "├─ ", "│  ", "   "
 
