@@ -423,6 +423,9 @@ def validate(scene_file, list_objects, strict):
             click.echo(line)
     for remark in found:
         click.echo(one_line(str(remark)), err=True)
+    if found and loaded.animation.frames > 1:
+        click.echo(f"note: the warnings are about frame 1 of {loaded.animation.frames} (the camera, lights "
+                   "and objects where the animation starts)", err=True)
 
 
 @main.command()

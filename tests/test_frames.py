@@ -83,6 +83,16 @@ def test_validate_checks_every_frame(run):
     assert result.output.endswith("; animated: 24 frames at 12 fps (0..2 s), 3 keyframed values\n")
 
 
+def test_validate_says_its_warnings_are_about_frame_1(run, tmp_path):
+    text = (tmp_path / "orbit.yaml").read_text()
+    (tmp_path / "bytes.yaml").write_text(text.replace("color: [0.45, 0.45, 0.45]", "color: [255, 255, 255]"))
+    result = run("validate", "bytes.yaml")
+    assert result.exit_code == 0 and "warning: [255, 255, 255] looks like 0-255 values" in result.stderr
+    assert result.stderr.endswith("note: the warnings are about frame 1 of 24 (the camera, lights and objects "
+                                  "where the animation starts)\n")
+    assert "note:" not in run("validate", "orbit.yaml").stderr
+
+
 @pytest.mark.parametrize("args, message", [
     (["--frames", "1-30", "-o", "f%d.png"], "--frames 1-30: orbit.yaml has 24 frames (1-24)"),
     (["--frames", "5-2", "-o", "f%d.png"], "--frames 5-2: give a range FIRST-LAST of frame numbers, from 1 (e.g. 1-24)"),
