@@ -114,10 +114,10 @@ class BVH:
             return
         n, t_min = o.shape[1], np.asarray(t_min, dtype=float)
         with np.errstate(divide="ignore"):
-            inv = 1.0 / d
+            rows = np.concatenate([o, 1.0 / d] + ([t_min[None]] if t_min.ndim else []))   # gathered as one
         for s in range(0, n, CHUNK):
             rays = np.arange(s, min(s + CHUNK, n))
-            rays = rays[self._meets(np.zeros(len(rays), np.int64), *self._gather(o, inv, rays, t_min, far))]
+            rays = rays[self._meets(np.zeros(len(rays), np.int64), *self._gather(rows, rays, t_min, far))]
             nodes = np.zeros(len(rays), dtype=np.int64)                              # the root
             while len(rays):
                 child = self.links[nodes, CHILD]
@@ -125,20 +125,21 @@ class BVH:
                 if leaf.any():
                     leaves(*self._leaf_pairs(rays[leaf], nodes[leaf]))
                 rays, left = rays[~leaf], child[~leaf]
-                ray = self._gather(o, inv, rays, t_min, far)           # once for both children
+                ray = self._gather(rows, rays, t_min, far)             # once for both children
                 hit_l, hit_r = self._meets(left, *ray), self._meets(left + 1, *ray)
                 rays, nodes = np.concatenate([rays[hit_l], rays[hit_r]]), np.concatenate([left[hit_l], left[hit_r] + 1])
 
     @staticmethod
-    def _gather(o, inv, rays, t_min, far):
+    def _gather(rows, rays, t_min, far):
         """The rays' origins, inverse directions, near and far limits (far read live)."""
-        return o[:, rays], inv[:, rays], t_min if t_min.ndim == 0 else t_min[rays], far[rays]
+        got = np.take(rows, rays, axis=1)
+        return got[:6], t_min if t_min.ndim == 0 else got[6], far[rays]
 
-    def _meets(self, nodes, o, inv, near, far):
-        """Whether each ray meets its node's box within [near, far] (the rays gathered)."""
+    def _meets(self, nodes, ray, near, far):
+        """Whether each ray meets its node's box within [near, far] (the rays gathered: o, 1 / d)."""
         box = np.take(self._columns, nodes, axis=1)            # (6, k): each bound contiguous
         with np.errstate(invalid="ignore"):
-            t_in, t_out = slab(*box, *o, *inv, near, far)
+            t_in, t_out = slab(*box, *ray, near, far)
         return t_in <= t_out
 
     def _leaf_pairs(self, rays, nodes):
