@@ -13,7 +13,6 @@ line prints; a scene's errors are SceneErrors, located `file:line:col: key.path`
 
 from __future__ import annotations
 
-import contextlib
 import os
 import time
 import warnings
@@ -85,7 +84,7 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
         _check_output(os.fspath(output), scene, False)
     from rtcli.render import Job
     job = Job(w, h, block_size, tile=tile, gamma=gamma, engine=engine, bvh=bvh, linear=linear)
-    with _settings(scene.model.settings, samples, max_depth) as s:
+    with scene.model.settings.overridden(samples, max_depth) as s:
         pixels, counts, seconds = _run(scene, job, workers, progress, notes)
         stats = RenderStats(w, h, s.samples, counts.engine, counts.primary, counts.shadow, counts.reflected,
                             counts.refracted, seconds, counts.load_seconds, counts.compile_seconds)
@@ -165,14 +164,3 @@ def check_engine(engine: str) -> None:
 def _check_output(path: str, scene: Scene, ids: bool) -> None:
     from rtcli.outputs import check_outputs
     check_outputs([(path, ids)], list(scene.inputs))
-
-
-@contextlib.contextmanager
-def _settings(settings, samples: int | None, max_depth: int | None):
-    """The scene's settings with samples and max_depth overridden for one render, then restored."""
-    saved = settings.samples, settings.max_depth
-    settings.samples, settings.max_depth = samples or saved[0], max_depth or saved[1]
-    try:
-        yield settings
-    finally:
-        settings.samples, settings.max_depth = saved

@@ -42,7 +42,7 @@ class ObjectRow:
     bounds: tuple | None           # world-space (lo, hi), None when unbounded
 
 
-def object_rows(scene: Scene, remarks: Remarks) -> list[ObjectRow]:
+def object_rows(scene: Scene) -> list[ObjectRow]:
     """One row per object, in id order."""
     rows = []
     for o in scene.objects:

@@ -419,7 +419,7 @@ def validate(scene_file, list_objects, strict):
         raise RtcliError(f"{found[0].where}: {found[0].message}{more}")
     click.echo(f"{shown(scene_file)}: ok: {summary(scene)}{frames}")
     if list_objects:
-        for line in checks.object_lines(checks.object_rows(scene, remarks)):
+        for line in checks.object_lines(checks.object_rows(scene)):
             click.echo(line)
     for remark in found:
         click.echo(one_line(str(remark)), err=True)

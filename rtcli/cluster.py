@@ -203,9 +203,8 @@ def _scene(spec: dict, blobs: dict, frame: int):
     with serving(files):
         animation = _kept(_animations, spec["key"], lambda: Animation(yamlfile.load(spec["scene_path"])), 2)
         scene = animation.scene(frame)
-    for name, value in spec["overrides"].items():
-        setattr(scene.settings, name, value)
-    return scene
+    from rtcli.frames import apply
+    return apply(scene, spec["overrides"])
 
 
 def _checked(spec: dict) -> None:

@@ -320,15 +320,11 @@ def explain(scene, x: int, y: int, *, width: int | None = None, height: int | No
         raise RtcliError(f"pixel ({x}, {y}) is outside the {w}x{h} image: x goes from 0 to {w - 1}, "
                          f"y from 0 to {h - 1}")
     settings = model.settings
-    saved = settings.samples, settings.max_depth
-    settings.samples, settings.max_depth = samples or settings.samples, max_depth or settings.max_depth
-    try:
+    with settings.overridden(samples, max_depth):
         wavefront.prepare(model, bvh)
         n = settings.samples
         xs, ys = sample_positions(np.array([x]), np.array([y]), n)
         trees = [trace_one(model, float(xs[k, 0]), float(ys[k, 0]), w, h) for k in range(n * n)]
-    finally:
-        settings.samples, settings.max_depth = saved
     value = np.array([t.value for t in trees]).reshape(n * n, 1, 3).mean(axis=0)     # as render_tile averages
     return Explanation(int(x), int(y), w, h, n, np.column_stack([xs[:, 0], ys[:, 0]]), trees, value[0],
                        to_8bit(value, gamma)[0], np.asarray(model.background, float), settings.specular, gamma)

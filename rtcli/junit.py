@@ -12,14 +12,12 @@ XML cannot hold (errors.one_line).
 from __future__ import annotations
 
 import datetime
-import os
 import socket
-import tempfile
 import xml.etree.ElementTree as ET
 
-from rtcli.errors import RtcliError, one_line, shown
+from rtcli.errors import one_line
 from rtcli.folders import Pair, counts, total_line
-from rtcli.writer import current_umask
+from rtcli.writer import write_atomic
 
 
 def junit_xml(pairs: list[Pair], properties: dict[str, str], seconds: float) -> bytes:
@@ -51,18 +49,4 @@ def junit_xml(pairs: list[Pair], properties: dict[str, str], seconds: float) -> 
 
 def write_junit(path: str, data: bytes) -> None:
     """Write the file atomically (a temporary file beside it, then a rename)."""
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=".rtcli-", suffix=".xml", dir=os.path.dirname(os.path.abspath(path)))
-    except OSError as e:
-        raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.chmod(tmp, 0o666 & ~current_umask())
-        os.replace(tmp, path)
-    except BaseException as e:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        if isinstance(e, OSError):
-            raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
-        raise
+    write_atomic(path, lambda f: f.write(data))

@@ -15,7 +15,7 @@ import numpy as np
 from PIL import Image
 
 from rtcli.errors import RtcliError, quoted, shown
-from rtcli.writer import write_temp
+from rtcli.writer import write_atomic
 
 FORMATS = {".apng": "PNG", ".gif": "GIF"}
 MAX_BYTES = 4 << 30                       # frames held in memory for one movie
@@ -48,13 +48,5 @@ def write_movie(path: str, frames: list[np.ndarray], fps: float) -> None:
     """Write uint8 (H, W, 3) frames as a movie at `fps` frames a second, looping."""
     fmt = movie_format(path)
     images = [Image.fromarray(f) for f in frames]
-    try:
-        tmp = write_temp(path, lambda f: images[0].save(f, format=fmt, save_all=True, append_images=images[1:],
-                                                        duration=1000 / fps, loop=0))
-        try:
-            os.replace(tmp, path)
-        except BaseException:
-            os.unlink(tmp)
-            raise
-    except OSError as e:
-        raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
+    write_atomic(path, lambda f: images[0].save(f, format=fmt, save_all=True, append_images=images[1:],
+                                                duration=1000 / fps, loop=0))

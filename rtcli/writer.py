@@ -136,6 +136,20 @@ def write_temp(path: str, save) -> str:
     return tmp
 
 
+def write_atomic(path: str, save) -> None:
+    """Write a file by save(file object) into a temporary file beside `path`, then rename it into
+    place: an interrupted or failed write leaves no partial file."""
+    try:
+        tmp = write_temp(path, save)
+        try:
+            os.replace(tmp, path)
+        except BaseException:
+            _remove(tmp)
+            raise
+    except OSError as e:
+        raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
+
+
 def _remove(path: str) -> None:
     try:
         os.unlink(path)

@@ -13,6 +13,22 @@ from rtcli.render import Job, render_tile
 from rtcli.scenefile import yamlfile
 from rtcli.scenefile.build import scene_from_docs
 
+# exact-value tests of shading: a tolerance, two light directions, a material that shows only its
+# specular or mirror term, and numbers written into YAML to the last digit
+RTOL = 1e-9
+E1, E2 = np.array([0.2, 0.4, 0.6]), np.array([0.9, 0.1, 0.3])
+DARK = "ambient: 0, diffuse: 0"
+
+
+def f(x: float) -> str:
+    """x in YAML, every digit kept."""
+    return format(float(x), ".17f")
+
+
+def vec(v) -> str:
+    """A vector in YAML, every digit kept."""
+    return "[" + ", ".join(f(x) for x in v) + "]"
+
 
 def scene_from_yaml(text: str, tmp_path=None, name: str = "scene.yaml"):
     """Build a Scene from YAML text; written to tmp_path when given (for includes and files)."""

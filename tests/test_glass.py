@@ -10,22 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import one_pixel, scene_from_yaml
+from helpers import DARK, E1, E2, RTOL, f, one_pixel, scene_from_yaml, vec
 
 from rtcli.core.dielectric import fresnel, indices, refracted_media, split
 from rtcli.core.materials import Material, MaterialTable
-
-RTOL = 1e-9
-E1, E2 = np.array([0.2, 0.4, 0.6]), np.array([0.9, 0.1, 0.3])
-DARK = "ambient: 0, diffuse: 0"
-
-
-def f(x: float) -> str:
-    return format(float(x), ".17f")
-
-
-def vec(v) -> str:
-    return "[" + ", ".join(f(x) for x in v) + "]"
 
 
 def scene(eye, look_at, objects: str, render: str = "", lights: str = "[]"):

@@ -10,23 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from helpers import one_pixel, scene_from_yaml
+from helpers import DARK, E1, E2, RTOL, one_pixel, scene_from_yaml, vec
 
 from rtcli.core import vec as vectors
 from rtcli.wavefront.intersect import find_first_hit, surface
 from rtcli.wavefront.rays import Rays
-
-RTOL = 1e-9
-E1, E2 = np.array([0.2, 0.4, 0.6]), np.array([0.9, 0.1, 0.3])
-DARK = "ambient: 0, diffuse: 0"
-
-
-def f(x: float) -> str:
-    return format(float(x), ".17f")
-
-
-def vec(v) -> str:
-    return "[" + ", ".join(f(x) for x in v) + "]"
 
 
 def scene(eye, look_at, objects: str, max_depth: int = 5, up=(0, 1, 0)):

@@ -124,11 +124,18 @@ def drop_stale_cache() -> None:
             pass
 
 
+_cache_checked = False
+
+
 def _load() -> str | None:
-    """Import the compiled integrator (numba); why not, if it cannot be."""
+    """Import the compiled integrator (numba); why not, if it cannot be. The cache is checked
+    against the sources once a process (a batch, a watch or a cluster worker renders many jobs)."""
+    global _cache_checked
     if not variants.ENABLED:
         return "numba is not installed (pip install -e '.[fast]' from rtcli's folder)"
-    drop_stale_cache()
+    if not _cache_checked:
+        drop_stale_cache()
+        _cache_checked = True
     try:
         import rtcli.compiled.integrator  # noqa: F401
     except ImportError as e:

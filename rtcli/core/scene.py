@@ -6,6 +6,7 @@ SceneObject, its shape, and a row of the arrays below.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 from dataclasses import dataclass, field
 
@@ -72,6 +73,17 @@ class Settings:
     epsilon: float = 1e-6            # self-intersection offset, relative to the scene's size
     medium_ior: float = 1.0          # index of refraction around every object (the camera's medium)
     total_internal_reflection: str = "drop"   # drop: the refracted weight is lost; reflect: to the mirror ray
+
+    @contextlib.contextmanager
+    def overridden(self, samples: int | None, max_depth: int | None):
+        """These settings with samples and max_depth overridden (when given) for one render, then
+        restored."""
+        saved = self.samples, self.max_depth
+        self.samples, self.max_depth = samples or saved[0], max_depth or saved[1]
+        try:
+            yield self
+        finally:
+            self.samples, self.max_depth = saved
 
 
 @dataclass

@@ -28,7 +28,7 @@ from rtcli.scenefile.limits import MAX_MESH_BYTES
 _READ = {"v": 3, "vt": 1, "vn": 3}      # statement -> how many numbers it needs at least
 _KEEP = {"v": 3, "vt": 2, "vn": 3}      # statement -> how many numbers are kept (vt's v defaults to 0)
 _NAMES = (("vertex", "vertices"), ("texture", "texture coordinates (vt)"), ("normal", "normals (vn)"))
-_MISSING = np.iinfo(np.int64).min       # an empty vt / vn field of a face corner
+_MISSING = obj_bulk.MISSING                # an empty vt / vn field of a face corner
 _MISSING_TEXT = str(_MISSING)
 
 
@@ -146,7 +146,7 @@ def _faces(src, line_nos, args, counts, totals):
         raise at(k, f"face corner {quoted(tokens[k])} has no vertex index")
     idx = [_resolve(f, np.repeat(c, corners), n, names, at)
            for f, c, n, names in zip(fields, counts, totals, _NAMES)]
-    tri = _fan(corners)
+    tri = obj_bulk.fan(corners)
     return tuple(i[tri] for i in idx)
 
 
@@ -195,12 +195,3 @@ def _resolve(raw, count_before, total, names, at):
         n, before = (total, "") if raw[k] > 0 else (int(count_before[k]), " before this line")
         raise at(k, f"{names[0]} index {raw[k]} out of range: {n} {names[1]} defined{before}")
     return idx
-
-
-def _fan(corners: np.ndarray) -> np.ndarray:
-    """(F, 3) positions into the flat corner list: polygon k gives (0, j, j+1), j = 1 .. k-2."""
-    first = np.cumsum(corners) - corners
-    ntri = corners - 2
-    base = np.repeat(first, ntri)
-    j = np.arange(int(ntri.sum())) - np.repeat(np.cumsum(ntri) - ntri, ntri) + 1
-    return np.stack([base, base + j, base + j + 1], axis=1)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-_MISSING = np.iinfo(np.int64).min       # an empty vt / vn field of a face corner (as in obj.py)
+MISSING = np.iinfo(np.int64).min        # an empty vt / vn field of a face corner (obj.py uses it too)
 _POW10 = 10.0 ** np.arange(23)          # exact doubles
 _EXACT = 2 ** 53                         # integers up to here are exact doubles
 _LF, _CR, _HASH, _MINUS, _PLUS, _DOT, _SLASH = 10, 13, 35, 45, 43, 46, 47
@@ -66,7 +66,7 @@ def _parse(data):
     if not faces:
         return (v, vt, vn, *(np.zeros((0, 3), np.int64) for _ in range(3)))
     corners = np.concatenate([f[0] for f in faces])
-    tri = _fan(corners)
+    tri = fan(corners)
     out = []
     for j, total in enumerate((len(v), len(vt), len(vn))):
         if all(f[1][j] is None for f in faces):                  # no vt (or vn) anywhere
@@ -115,7 +115,7 @@ def _block(b, numbers, faces, counts):
         fields = _pieces(lambda *a: _corners(*a, slashes), b, starts[token], ends[token])
         f_line, before = None, []
         for j, kw in enumerate(("v", "vt", "vn")):
-            if (fields[j] == _MISSING).all():
+            if (fields[j] == MISSING).all():
                 fields[j] = None                                 # a field no corner has
             if fields[j] is None or not (fields[j] < 0).any():
                 before.append(0)                                 # no negative index to count back from
@@ -216,7 +216,7 @@ def _numbers(b, starts, ends):
 
 
 def _corners(b, starts, ends, slashes=True):
-    """The v, vt, vn fields of face corners v, v/vt, v//vn, v/vt/vn as int64 (_MISSING where empty);
+    """The v, vt, vn fields of face corners v, v/vt, v//vn, v/vt/vn as int64 (MISSING where empty);
     `slashes`: whether there is a '/' to look for."""
     n = len(starts)
     first_slash, second_slash = ends.copy(), ends.copy()          # where fields 0 and 1 end
@@ -228,7 +228,7 @@ def _corners(b, starts, ends, slashes=True):
             second_slash = np.where(slash & (first_slash < ends), starts + k, second_slash)
             first_slash = np.where(slash & (first_slash == ends), starts + k, first_slash)
     vertex = _integers(b, starts, first_slash)
-    if (vertex == _MISSING).any():
+    if (vertex == MISSING).any():
         raise _GiveUp                                             # no vertex index
     texture = _integers(b, np.minimum(first_slash + 1, ends), second_slash)
     normal = _integers(b, np.minimum(second_slash + 1, ends), ends)
@@ -236,7 +236,7 @@ def _corners(b, starts, ends, slashes=True):
 
 
 def _integers(b, starts, ends):
-    """Fields [-]digits as int64, _MISSING for an empty one; _GiveUp for anything else."""
+    """Fields [-]digits as int64, MISSING for an empty one; _GiveUp for anything else."""
     n = len(starts)
     value, digits, bad = np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, bool)
     for k, c, live in _columns(b, starts, ends):
@@ -248,20 +248,20 @@ def _integers(b, starts, ends):
     negative = (ends > starts) & (b[np.minimum(starts, len(b) - 1)] == _MINUS)
     if (bad | (digits > 18) | (negative & (digits == 0))).any():
         raise _GiveUp
-    return np.where(digits == 0, _MISSING, np.where(negative, -value, value))
+    return np.where(digits == 0, MISSING, np.where(negative, -value, value))
 
 
 def _resolve(raw, before, total):
     """0-based indices as obj._resolve makes them; _GiveUp for 0 or an index out of range."""
     if (raw == 0).any():
         raise _GiveUp
-    idx = np.where(raw > 0, raw - 1, np.where(raw == _MISSING, -1, before + raw))
-    if ((idx >= total) | ((raw < 0) & (raw != _MISSING) & (idx < 0))).any():
+    idx = np.where(raw > 0, raw - 1, np.where(raw == MISSING, -1, before + raw))
+    if ((idx >= total) | ((raw < 0) & (raw != MISSING) & (idx < 0))).any():
         raise _GiveUp
     return idx
 
 
-def _fan(corners):
+def fan(corners: np.ndarray) -> np.ndarray:
     """(F, 3) positions into the flat corner list: polygon k gives (0, j, j+1), j = 1 .. k-2."""
     first = np.cumsum(corners) - corners
     ntri = corners - 2
