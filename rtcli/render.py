@@ -178,11 +178,14 @@ def prepare(scene: Scene, job: Job, traced: int, notes=None):
 
 def _weighed(scene: Scene, job: Job, traced: int) -> int:
     """The rays `auto` weighs: a small job takes the numpy engine to spare numba's start-up, unless
-    that engine would load compiled BVH walks anyway (meshes, sets of spheres) and the integrator
+    the compiled engine starts without numba (its machine code file), or the numpy engine would
+    load compiled BVH walks anyway (meshes, sets of spheres) and the integrator
     is cached: then the compiled engine starts as fast and traces faster, so the job counts as a
     large one. (Not cached, it would compile for a minute; the walks compile in seconds.)"""
     if job.engine != "auto" or traced >= compiled.AUTO_RAYS or not variants.ENABLED:
         return traced
+    if compiled.starts_at_once():
+        return compiled.AUTO_RAYS
     wavefront.build(scene, job.bvh)
     if wavefront.uses_compiled_walks(scene) and compiled.ready_to_load():
         return compiled.AUTO_RAYS

@@ -65,9 +65,9 @@ def test_bvh_shadow_feelers_and_surfaces_equal_brute_force(yaml_scene):
 def test_bvh_render_is_identical(yaml_scene):
     """A whole render is byte-identical with and without the BVH."""
     scene = random_scene(yaml_scene, 4)
-    brute, _ = render(scene, Job(64, 48, bvh=False))
+    brute, _ = render(scene, Job(64, 48, bvh=False, engine="numpy"))
     assert scene.accel is None
-    fast, _ = render(scene, Job(64, 48))
+    fast, _ = render(scene, Job(64, 48, engine="numpy"))
     assert scene.accel is not None
     np.testing.assert_array_equal(fast, brute)
 

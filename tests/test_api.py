@@ -120,7 +120,7 @@ def test_linear_colors_convert_to_the_8bit_image_exactly(spec):
 
 
 def test_images_show_in_jupyter_convert_to_pillow_and_keep_stats(spec):
-    image = rtcli.render(spec, workers=1)
+    image = rtcli.render(spec, workers=1, engine="numpy")
     shown = Image.open(io.BytesIO(image._repr_png_()))
     assert np.array_equal(np.asarray(shown.convert("RGB")), image)
     assert image.to_pil().mode == "RGB" and image.to_pil().size == (32, 24)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from bvh_reference import build as reference_build
 
-from rtcli import variants
+from rtcli import machinecode, variants
 from rtcli.core import bvh_build
 from rtcli.core.bvh import BVH
 from rtcli.scenefile.obj import read_obj
@@ -102,8 +102,9 @@ def test_torus100k_compiled_is_the_reference_tree():
     same_tree(bvh_build.compiled_build(lo, hi, 4, 12), reference_build(lo, hi, 4, 12))
 
 
-def test_build_takes_the_compiled_build_only_once_numba_is_loaded(monkeypatch):
+def test_build_takes_the_compiled_build_once_numba_is_loaded_or_its_machine_code_is_at_hand(monkeypatch):
     calls = []
+    monkeypatch.setattr(machinecode, "load", lambda name: None)
     monkeypatch.setattr(bvh_build, "compiled_build", lambda *a: calls.append(len(a[0])) or bvh_build.numpy_build(*a))
     monkeypatch.setattr(variants, "ENABLED", True)
     lo = np.random.default_rng(1).uniform(0, 1, (50, 3))
@@ -113,6 +114,9 @@ def test_build_takes_the_compiled_build_only_once_numba_is_loaded(monkeypatch):
     monkeypatch.delitem(sys.modules, "numba")
     BVH(lo, lo + 0.1)
     assert calls == [50]
+    monkeypatch.setattr(machinecode, "load", lambda name: name == bvh_build.LEVELS and object())
+    BVH(lo, lo + 0.1)
+    assert calls == [50, 50]
 
 
 # --- a mesh builds its tree when first asked for ---

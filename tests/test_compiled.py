@@ -578,6 +578,7 @@ def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_an
     it is cached)."""
     from rtcli.render import prepare
     monkeypatch.setattr(fast, "ready_to_load", lambda: True)
+    monkeypatch.setattr(fast, "starts_at_once", lambda: False)          # no machine code file
     small = fast.AUTO_RAYS // 2
     for name, expected in (("scenes/whitted.yaml", None), ("bench/torus100k.yaml", fast.Compiled),
                            ("bench/spheres1k.yaml", fast.Compiled)):
@@ -592,6 +593,7 @@ def test_auto_stays_on_numpy_for_a_small_job_before_the_first_compile(monkeypatc
     seconds: a small mesh job stays on numpy. ready_to_load reads the cache it is given."""
     from rtcli.render import prepare
     monkeypatch.setattr(fast, "ready_to_load", lambda: False)
+    monkeypatch.setattr(fast, "starts_at_once", lambda: False)
     scene = load_scene(str(ROOT / "bench/torus100k.yaml"))
     assert prepare(scene, Job(64, 48, engine="auto"), fast.AUTO_RAYS // 2)[0] is None
     env = {**os.environ, "RTCLI_CACHE_DIR": str(tmp_path)}

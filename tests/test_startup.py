@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from rtcli import compiled as fast
-from rtcli import variants
+from rtcli import machinecode, variants
 from rtcli.compiled import loading
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
@@ -150,7 +150,7 @@ def test_numba_writes_to_the_per_user_cache_when_the_sources_are_read_only(warm,
     user = tmp_path / "user-cache"
     cache = seeded(user / "rtcli" / "numba", TRACE_CAMERA)
     code = textwrap.dedent("""
-        from rtcli import variants
+        from rtcli import machinecode, variants
         real = variants.writable
         variants.writable = lambda f: not f.startswith(variants.PACKAGE_DIR) and real(f)
         from rtcli.cli import main
@@ -257,14 +257,20 @@ def test_a_forecast_of_numbas_cache(tmp_path, monkeypatch):
     assert len(heard) == 2                                            # in memory already: not even looked up
 
 
-def test_after_warmup_no_scene_compiles_anything(warm):
-    """The warmup's calls have the argument types of every render: one machine code each."""
+def test_after_warmup_no_scene_compiles_anything(warm, monkeypatch):
+    """The warmup's calls have the argument types of every render: every scene's arguments fit
+    the integrator's machine code file, and through numba there is one machine code each."""
     from rtcli.compiled import query
     from rtcli.compiled.integrator import trace_camera
     from rtcli.render import Job, render
     from rtcli.scenefile.build import load_scene
-    for path in sorted((ROOT / "scenes").glob("*.yaml")) + sorted((ROOT / "bench").glob("*.yaml")):
-        scene = load_scene(str(path))
+    scenes = [load_scene(str(p)) for p in sorted((ROOT / "scenes").glob("*.yaml")) +
+              sorted((ROOT / "bench").glob("*.yaml"))]
+    for scene in scenes:
+        assert fast.choose(scene, "compiled").entry is not None
+    monkeypatch.setattr(machinecode, "ENABLED", False)
+    monkeypatch.setattr(machinecode, "_loaded", {})
+    for scene in scenes:
         for engine in ("numpy", "compiled") if fast.unsupported(scene) is None else ("numpy",):
             render(scene, Job(16, 12, engine=engine))
     for entry in (variants.compiled(trace_camera), query.WALK_RAYS_TRIANGLES, query.WALK_RAYS_OBJECTS):

@@ -8,30 +8,33 @@ renders every supported scene both ways). `--engine auto` (the default) takes it
 when numba is installed and the scene holds only what it supports
 (pack.unsupported), else the numpy engine.
 
-numba is imported, and the integrator compiled or loaded from numba's on-disk
-cache, only when a render takes this path. numba's cache notices when a
-function's own file changes, not when a function it calls (in another file) does,
-so `drop_stale_cache` empties it whenever any source the engine is made of changes.
+The integrator starts from its machine code file (rtcli/machinecode.py) when there is
+one for this process, in about 0.1 s and without numba. Otherwise numba is imported,
+and the integrator compiled or loaded from numba's on-disk cache, only when a render
+takes this path; that writes the machine code file after a compile (and `rtcli warmup`
+writes it). numba's cache notices when a function's own file changes, not when a
+function it calls (in another file) does, so `drop_stale_cache` empties it, and the
+machine code files, whenever any source the engine is made of changes.
 
-Loading numba and the cached code takes about 0.8 s, more than the numpy engine
-needs for a small image, so `auto` takes the compiled engine only from
-AUTO_RAYS primary rays up (a 1280x800 image, or 640x480 with --samples 2), and for any
-size when the numpy engine would load compiled BVH walks itself (meshes, sets of
-spheres) and the integrator's code is already cached (rtcli/render.py).
+Loading numba and its cached code takes about 0.5 s, more than the numpy engine needs
+for a small image, so without a machine code file `auto` takes the compiled engine only
+from AUTO_RAYS primary rays up (a 1280x800 image, or 640x480 with --samples 2), and for
+any size when the numpy engine would load compiled BVH walks itself (meshes, sets of
+spheres) and the integrator's code is already cached (rtcli/render.py). With the file,
+it starts at once, and `auto` takes it for any size.
 """
 
 from __future__ import annotations
 
-import hashlib
 import os
 import time
 from pathlib import Path
 
 import numpy as np
 
-from rtcli import variants
+from rtcli import machinecode, variants
 from rtcli.compiled.loading import Load, cached, ready
-from rtcli.compiled.pack import geometry, looks, unsupported
+from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
 from rtcli.stats import Stats
@@ -42,23 +45,42 @@ __all__ = ["AUTO_RAYS", "Compiled", "Load", "choose", "unsupported"]
 class Compiled:
     """A scene packed for the compiled integrator; trace_pixels() stands in for camera rays + trace.
 
-    Making one compiles the integrator, or loads it from numba's cache, at once: worker
-    processes forked afterwards inherit the machine code."""
+    Making one loads the integrator's machine code at once, from its machine code file
+    (rtcli/machinecode.py) or through numba (from numba's cache, or compiling it):
+    worker processes forked afterwards inherit it."""
 
     def __init__(self, scene, bvh: bool = True, notes=None, start: float | None = None):
+        start = time.perf_counter() if start is None else start
         self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh)
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
+        self.frames = frames(self.looks.max_depth)
         nowhere, none = Camera(*np.zeros((4, 3))), np.zeros(0)
-        self.load = ready([_trace_camera()], lambda: self.trace_pixels(nowhere, none, none, 1, 1, Stats()),
-                          "the render engine", "about a minute", notes, start)     # no ray: just the machine code
+        self.empty_call = args = self._args(nowhere.row, none, none, 1, 1, np.zeros(4, dtype=np.int64),
+                                            np.empty((0, 3)))       # no ray: the arguments' layout
+        self.entry = machinecode.load(ENTRY)
+        if self.entry is not None and self.entry.fits(args):
+            self.load = Load(time.perf_counter() - start)
+            return
+        self.entry = None
+        self.load = ready([_trace_camera()], lambda: _trace_camera()(*args), "the render engine", "about a minute",
+                          notes, start)     # no ray: just the machine code
+        if self.load.compile_seconds:                   # so that later processes start without numba
+            machinecode.make(ENTRY, _trace_camera(), args)
+
+    def _args(self, cam_row, x, y, nc, nr, counts, out) -> tuple:
+        return self.geometry, self.looks, cam_row, x, y, nc, nr, counts, self.stack, out, self.frames
 
     def trace_pixels(self, cam, x: np.ndarray, y: np.ndarray, nc: int, nr: int, stats: Stats) -> np.ndarray:
         """Colors (n, 3) of the camera's rays through pixel coordinates (x, y)."""
         counts = np.zeros(4, dtype=np.int64)
         x, y = (np.ascontiguousarray(v, dtype=float) for v in (x, y))
-        colors = _trace_camera()(self.geometry, self.looks, cam.row, x, y, nc, nr, counts, self.stack)
+        colors = np.empty((len(x), 3))
+        (self.entry or _trace_camera())(*self._args(cam.row, x, y, nc, nr, counts, colors))
         stats.add(Stats(*(int(c) for c in counts)))
         return colors
+
+
+ENTRY = "trace_camera"
 
 
 def _trace_camera():
@@ -67,16 +89,8 @@ def _trace_camera():
 
 
 PACKAGE = Path(variants.PACKAGE_DIR)
-SOURCES = ("variants.py", "core", "shapes", "compiled")     # what the machine code is made of
 STAMP = "rtcli-compiled.sha256"
-
-
-def _sources() -> list[Path]:
-    files = []
-    for name in SOURCES:
-        path = PACKAGE / name
-        files += sorted(path.glob("*.py")) if path.is_dir() else [path]
-    return files
+CACHED = ("*.nbi", "*.nbc", "rtcli-*.o", "rtcli-*.json")     # numba's files and the machine code files
 
 
 def cache_places() -> list[tuple[list[Path], bool]]:
@@ -106,20 +120,18 @@ def drop_stale_cache() -> None:
     sources differ from the ones it was compiled from (a fingerprint kept beside it,
     rtcli-compiled.sha256 in the compiled folder's cache). numba's own check only looks at the
     file of the function it loads, not at the files of the kernels compiled into it."""
-    digest = hashlib.sha256()
-    for f in _sources():
-        digest.update(f.name.encode() + f.read_bytes())
+    digest = machinecode.sources_digest(PACKAGE)
     for folders, used in cache_places():
         stamp = folders[0] / STAMP
         try:
-            if stamp.exists() and stamp.read_text() == digest.hexdigest():
+            if stamp.exists() and stamp.read_text() == digest:
                 continue
-            found = [f for folder in folders if folder.is_dir() for f in folder.glob("*.nb[ic]")]
+            found = [f for folder in folders if folder.is_dir() for pattern in CACHED for f in folder.glob(pattern)]
             for f in found:
                 f.unlink()
             if used or found:
                 stamp.parent.mkdir(parents=True, exist_ok=True)
-                stamp.write_text(digest.hexdigest())
+                stamp.write_text(digest)
         except OSError:                # not writable: numba cannot use it either
             pass
 
@@ -128,14 +140,18 @@ _cache_checked = False
 
 
 def _load() -> str | None:
-    """Import the compiled integrator (numba); why not, if it cannot be. The cache is checked
-    against the sources once a process (a batch, a watch or a cluster worker renders many jobs)."""
+    """Make the compiled integrator ready to load: its machine code file (rtcli/machinecode.py)
+    when there is one for this process, else numba and the integrator imported; why not, if it
+    cannot be. The cache is checked against the sources once a process (a batch, a watch or a
+    cluster worker renders many jobs)."""
     global _cache_checked
     if not variants.ENABLED:
         return "numba is not installed (pip install -e '.[fast]' from rtcli's folder)"
     if not _cache_checked:
         drop_stale_cache()
         _cache_checked = True
+    if machinecode.load(ENTRY) is not None:
+        return None
     try:
         import rtcli.compiled.integrator  # noqa: F401
     except ImportError as e:
@@ -147,12 +163,20 @@ AUTO_RAYS = 1_000_000
 
 
 def ready_to_load() -> bool:
-    """Whether the compiled integrator's machine code is in numba's cache (or in memory), so that
-    starting the engine loads it rather than compiling for a minute: a forecast (loading.cached)."""
+    """Whether the compiled integrator's machine code is at hand (its file, numba's cache, or in
+    memory), so that starting the engine loads it rather than compiling for a minute: a forecast
+    (loading.cached)."""
     if _load() is not None:
         return False
+    if machinecode.load(ENTRY) is not None:
+        return True
     entry = _trace_camera()
     return bool(entry.signatures) or cached(entry) is True
+
+
+def starts_at_once() -> bool:
+    """Whether the compiled integrator would start from its machine code file, without numba."""
+    return _load() is None and machinecode.load(ENTRY) is not None
 
 
 def choose(scene, engine: str, rays: int = AUTO_RAYS, bvh: bool = True, notes=None) -> Compiled | None:

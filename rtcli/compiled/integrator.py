@@ -13,14 +13,31 @@ shapes' normals and (u, v) (rtcli/shapes/), textures, lights and the local term
 this engine's own is the order of work: a loop over depth with a stack of frames in
 place of recursion (numba's recursion is slow and breaks its on-disk cache).
 frames[L] holds the hit at depth L + 1 while its secondary rays are traced, and the
-media of the ray that made it; its columns have the names below.
+media of the ray that made it; its columns are named in compiled/pack.py.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from rtcli.compiled.pack import CSG_KIND, KIND, XFORM
+from rtcli.compiled.pack import (
+    COLOR_SUM,
+    CSG_KIND,
+    ENTERING,
+    KIND,
+    MATERIAL_OF,
+    MEDIA_COUNT,
+    MEDIA_IOR,
+    NG,
+    REFRACTED_DIR,
+    STAGE,
+    W_REFLECT,
+    W_REFRACT,
+    XFORM,
+    D,
+    N,
+    P,
+)
 from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, material_of, scene_hit
 from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.camera import primary_ray
@@ -33,13 +50,6 @@ from rtcli.core.transform import normal_to_world, ray_to_object
 from rtcli.core.vec import dot, reflect, refract, unit
 from rtcli.variants import per_ray
 
-# A frame: the local color so far, the hit point p, the facing shading normal n and geometric
-# normal ng, the unit direction D of the ray that hit, entering (1 or 0), the material, which
-# secondary ray comes next (STAGE: 0 the mirror ray, 1 the refracted ray, 2 done), the weights
-# of the mirror and refracted rays, the refracted direction, and the media the ray is in: how
-# many, then their iors (max_depth slots from MEDIA_IOR on).
-COLOR_SUM, P, N, NG, D, ENTERING, MATERIAL_OF, STAGE = 0, 3, 6, 9, 12, 15, 16, 17
-W_REFLECT, W_REFRACT, REFRACTED_DIR, MEDIA_COUNT, MEDIA_IOR = 18, 21, 24, 27, 28
 SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
 
 
@@ -215,12 +225,10 @@ def radiance(g, s, ray, counts, frames, stack):
 
 
 @per_ray(entry=True)
-def trace_camera(g, s, cam, x, y, nc, nr, counts, stack):
-    """(n, 3) colors of the primary rays through the pixel coordinates (x, y) (n,) of a camera
-    (its row: rtcli/core/camera.py)."""
-    n = len(x)
-    out = np.empty((n, 3))
-    frames = np.empty((max(s.max_depth, 1), MEDIA_IOR + s.max_depth))
-    for i in range(n):
+def trace_camera(g, s, cam, x, y, nc, nr, counts, stack, out, frames):
+    """The colors of the primary rays through the pixel coordinates (x, y) (n,) of a camera (its
+    row: rtcli/core/camera.py) into out (n, 3). The caller gives the scratch: stack (the
+    traversal's) and frames (pack.frames), so that this entry allocates nothing
+    and runs as machine code without numba (rtcli/compiled/machine.py)."""
+    for i in range(len(x)):
         out[i] = radiance(g, s, primary_ray(cam, x[i], y[i], nc, nr), counts, frames, stack)
-    return out

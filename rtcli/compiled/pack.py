@@ -57,6 +57,15 @@ PROGRAM, LENGTH, LEAF_COUNT, SPANS, CHILDREN, SCRATCH, BOUNDED, LO, HI = 0, 1, 2
 LEAF = len(OPS)                                    # the program's code for a leaf (the ops are csg's)
 ROW, DEPTH, PATH = 1, 2, 4                         # columns of leaves (KIND and MATERIAL as in ints)
 
+# The integrator's frames (compiled/integrator.py), one per depth. A frame: the local color so
+# far, the hit point p, the facing shading normal n and geometric normal ng, the unit direction
+# D of the ray that hit, entering (1 or 0), the material, which secondary ray comes next (STAGE:
+# 0 the mirror ray, 1 the refracted ray, 2 done), the weights of the mirror and refracted rays,
+# the refracted direction, and the media the ray is in: how many, then their iors (max_depth
+# slots from MEDIA_IOR on).
+COLOR_SUM, P, N, NG, D, ENTERING, MATERIAL_OF, STAGE = 0, 3, 6, 9, 12, 15, 16, 17
+W_REFLECT, W_REFRACT, REFRACTED_DIR, MEDIA_COUNT, MEDIA_IOR = 18, 21, 24, 27, 28
+
 # Few arrays on purpose: numba passes each array argument as several machine words.
 Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool program leaves")
 Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear fresnel filters texture "
@@ -224,3 +233,9 @@ def looks(scene) -> Looks:
                  float(scene.offset), int(scene.settings.max_depth), scene.settings.specular == "blinn",
                  float(scene.settings.medium_ior), scene.settings.total_internal_reflection == "reflect",
                  bool(table.filters.any()))
+
+
+def frames(max_depth: int) -> np.ndarray:
+    """The integrator's scratch: a frame per depth (at least one), each its columns above and then
+    max_depth media slots."""
+    return np.empty((max(max_depth, 1), MEDIA_IOR + max_depth))

@@ -15,7 +15,7 @@ from functools import partial
 
 import numpy as np
 
-from rtcli import variants
+from rtcli import machinecode, variants
 from rtcli.compiled.loading import Load, ready
 
 
@@ -38,10 +38,11 @@ def _scenes():
             Scene(camera, [mesh, floor], materials, lights, eye=np.array([0.0, 2, 8])))
 
 
-def warmup(notes=None) -> list[tuple[str, Load]]:
+def warmup(notes=None) -> tuple[list[tuple[str, Load]], list[str]]:
     """Load or compile the machine code of every compiled entry point: (what, how long) for the
-    render engine and the numpy engine's walks. `notes` hears when one compiles (default: stderr).
-    RtcliError when numba cannot be loaded."""
+    render engine and the numpy engine's walks, and the entries with a machine code file
+    (machine_code). `notes` hears when one compiles (default: stderr). RtcliError when numba
+    cannot be loaded."""
     from rtcli import compiled, wavefront
     from rtcli.errors import RtcliError
     if not variants.ENABLED:
@@ -55,4 +56,29 @@ def warmup(notes=None) -> list[tuple[str, Load]]:
         found.append(wavefront.walks(scene))
     entries = [e for scene_entries, _ in found for e in scene_entries]
     walks = ready(entries, lambda: [call() for _, call in found], wavefront.WALKS, "about half a minute", notes, start)
-    return [("the render engine (compiled)", engine.load), (wavefront.WALKS, walks)]
+    return [("the render engine (compiled)", engine.load), (wavefront.WALKS, walks)], machine_code(engine)
+
+
+def machine_code(engine) -> list[str]:
+    """Write the machine code files (rtcli/machinecode.py) of the integrator, unless `engine` (a
+    Compiled) was loaded from its file, and of the BVH build, unless its file is at hand; the
+    entries that have a usable file afterwards."""
+    from rtcli.compiled import ENTRY, _trace_camera
+    from rtcli.core.bvh_build import LEVELS, levels, levels_args
+    if engine.entry is None:
+        machinecode.make(ENTRY, _trace_camera(), engine.empty_call)
+    if machinecode.load(LEVELS) is None:
+        lo = np.random.default_rng(0).random((64, 3))
+        args = levels_args(lo, lo + 0.1, 2, 12)
+        run = variants.compiled(levels)
+        run(*args)
+        machinecode.make(LEVELS, run, args, results=2)
+    return [name for name in (ENTRY, LEVELS) if machinecode.load(name) is not None]
+
+
+def bytecode() -> bool:
+    """Compile rtcli's Python files to bytecode where Python keeps it (each folder's __pycache__),
+    so that no run compiles them again (a run that may not write bytecode, PYTHONDONTWRITEBYTECODE,
+    would every time); whether that worked."""
+    import compileall
+    return bool(compileall.compile_dir(variants.PACKAGE_DIR, quiet=2))

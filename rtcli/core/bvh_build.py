@@ -15,8 +15,9 @@ Two builds make the same tree, number for number (tests/test_bvh.py):
   contiguous rows.
 - `levels`, per node and per primitive (python and compiled variants, rtcli/variants.py):
   the compiled one builds 100,000 triangles' tree in a few hundredths of a second.
-`build` takes the compiled one when numba is already loaded (a render loads it for
-its walks anyway), so that checking a scene never waits for numba to start.
+`build` takes the compiled one when its machine code file is at hand (rtcli/machinecode.py:
+no numba needed) or numba is already loaded (a render loads it for its walks anyway), so
+that checking a scene never waits for numba to start.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ import sys
 
 import numpy as np
 
-from rtcli import variants
+from rtcli import machinecode, variants
 from rtcli.variants import INF, per_ray
 
 
@@ -34,28 +35,55 @@ def build(lo, hi, leaf_size, bins):
 
     lo, hi: (m, 3) primitive boxes; the node boxes come back as (k, 3) arrays.
     """
-    if variants.ENABLED and "numba" in sys.modules and len(lo) > leaf_size:
+    if variants.ENABLED and len(lo) > leaf_size and ("numba" in sys.modules or machinecode.load(LEVELS)):
         return compiled_build(lo, hi, leaf_size, bins)
     return numpy_build(lo, hi, leaf_size, bins)
 
 
+LEVELS = "levels"                 # the machine code file of `levels` (rtcli/machinecode.py)
+
+
 def compiled_build(lo, hi, leaf_size, bins, variant=None):
-    """`levels` run by its compiled variant (or by `variant`, say variants.python(levels))."""
-    m = len(lo)
-    lo, hi = (np.ascontiguousarray(x, dtype=np.float64) for x in (lo, hi))
-    size = max(2 * m - 1, 1)                               # a binary tree with m non-empty leaves
-    n_lo, n_hi = np.empty((size, 3)), np.empty((size, 3))
-    child, start, count = (np.empty(size, dtype=np.int64) for _ in range(3))
-    perm = np.empty(m, dtype=np.int64)
-    run = variant or variants.compiled(levels)
-    nodes, depth = run(lo, hi, leaf_size, bins, n_lo, n_hi, child, start, count, perm)
+    """`levels` run by its compiled variant: its machine code file when there is one, else numba
+    (or by `variant`, say variants.python(levels))."""
+    args = levels_args(lo, hi, leaf_size, bins)
+    run = variant or machinecode.entry(LEVELS, lambda: variants.compiled(levels), args)
+    nodes, depth = run(*args)
+    n_lo, n_hi, child, start, count, perm = args[4:10]
     return n_lo[:nodes], n_hi[:nodes], child[:nodes], start[:nodes], count[:nodes], perm, int(depth)
 
 
+def levels_args(lo, hi, leaf_size: int, bins: int) -> tuple:
+    """The arguments of `levels` for m primitives: the boxes, the tree's arrays to fill, sized for a
+    binary tree with m non-empty leaves, and the scratch."""
+    m = len(lo)
+    lo, hi = (np.ascontiguousarray(x, dtype=np.float64) for x in (lo, hi))
+    size = max(2 * m - 1, 1)
+    n_lo, n_hi = np.empty((size, 3)), np.empty((size, 3))
+    child, start, count = (np.empty(size, dtype=np.int64) for _ in range(3))
+    perm = np.empty(m, dtype=np.int64)
+    return (lo, hi, int(leaf_size), int(bins), n_lo, n_hi, child, start, count, perm) + scratch(lo, hi, bins)
+
+
+def scratch(lo, hi, bins: int) -> tuple:
+    """The working arrays of `levels` for m primitives with boxes lo, hi (m, 3): the primitives of a
+    level in node order (work) with their boxes (p_lo, p_hi), the same three for the next level, the
+    node sizes and bounds of this level and the next, and per node the bins' counts and boxes, the
+    counts and areas right of each cut and the bins' scale per axis. The caller makes them, so that
+    `levels` allocates nothing (it runs as machine code without numba: rtcli/compiled/machine.py)."""
+    m = len(lo)
+    return (np.arange(m), lo.copy(), hi.copy(), np.empty(m, dtype=np.int64), np.empty((m, 3)), np.empty((m, 3)),
+            np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64), np.empty((m, 4, 3)), np.empty((m, 4, 3)),
+            np.empty((3, bins), dtype=np.int64), np.empty((3, bins, 3)), np.empty((3, bins, 3)),
+            np.empty(bins, dtype=np.int64), np.empty(bins), np.empty(3))
+
+
 @per_ray(entry=True)
-def levels(lo, hi, leaf_size, bins, n_lo, n_hi, child, start, count, perm):
+def levels(lo, hi, leaf_size, bins, n_lo, n_hi, child, start, count, perm, work, p_lo, p_hi, work2, p_lo2, p_hi2,
+           sizes, next_sizes, bounds, next_bounds, n, b_lo, b_hi, right_n, right_area, scale):
     """The tree of `numpy_build`, node by node, into n_lo, n_hi (nodes, 3), child, start,
-    count (nodes,) and perm (m,); returns (nodes, depth).
+    count (nodes,) and perm (m,); returns (nodes, depth). The other arrays are its scratch
+    (`scratch` makes them).
 
     The same operations on the same numbers, so the same costs and the same cuts:
     centroids are (lo + hi) / 2, and minima and maxima of finite numbers are the same
@@ -64,14 +92,6 @@ def levels(lo, hi, leaf_size, bins, n_lo, n_hi, child, start, count, perm):
     arrays, leaves left out), and a split sums up its children's boxes and centroid
     bounds as it writes them, so that each level reads its primitives twice, in order."""
     m = lo.shape[0]
-    work, p_lo, p_hi = np.arange(m), lo.copy(), hi.copy()
-    work2, p_lo2, p_hi2 = np.empty(m, dtype=np.int64), np.empty((m, 3)), np.empty((m, 3))
-    sizes, next_sizes = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
-    bounds, next_bounds = np.empty((m, 4, 3)), np.empty((m, 4, 3))     # per node: box lo, hi; centroids' lo, hi
-    n = np.empty((3, bins), dtype=np.int64)
-    b_lo, b_hi = np.empty((3, bins, 3)), np.empty((3, bins, 3))
-    right_n, right_area = np.empty(bins, dtype=np.int64), np.empty(bins)
-    scale = np.empty(3)
     for j in range(3):
         bounds[0, 0, j], bounds[0, 1, j] = lo[0, j], hi[0, j]
         bounds[0, 2, j] = bounds[0, 3, j] = (lo[0, j] + hi[0, j]) / 2
