@@ -2,28 +2,31 @@
 
 numba's on-disk cache saves the minute of compiling, but a process that loads it still
 imports numba and sets up its typing and lowering tables, about 0.4 s of every render:
-more than the whole trace of a 640x480 image. So when numba has compiled an entry point
-(the integrator, compiled/integrator.py's trace_camera; the BVH build, core/bvh_build.py's
-levels), `make` also writes its machine code to a file beside numba's cache, and `load`
-links that file into the process with llvmlite (numba's own LLVM binding, 0.05 s to
-import) and calls it through ctypes. It is the same machine code numba runs: the entry
-is wrapped in a C function (numba's cfunc) that rebuilds the arguments from a flat list
-of words, so the pixels are the same bit for bit (tests/test_machinecode.py).
+more than the whole trace of a 640x480 image, and up to a second more when the 180 MB
+LLVM library has to come back from disk. So when numba has compiled an entry point (the
+integrator, compiled/integrator.py's trace_camera; the BVH build, core/bvh_build.py's
+levels), `make` also writes its machine code as a small shared library beside numba's
+cache (position-independent object code from numba's optimised module, linked by the C
+compiler, `cc`), and `load` opens it with ctypes: no numba, no LLVM, about a millisecond.
+It is the same code numba runs: the entry is wrapped in a C function (numba's cfunc) that
+rebuilds the arguments from a flat list of words, so the pixels are the same bit for bit
+(tests/test_machinecode.py).
 
 The arguments of an entry are arrays, numbers, bools and namedtuples of those (the
 compiled engine's Geometry and Looks). Their `layout` (each leaf's kind, an array's dtype
 and number of dimensions, a namedtuple's fields) is fixed when the file is made; a call
 passes each array as its address and shape (C order), each int and bool as a word and
 each float as a float. A file is used only when its key matches this process: rtcli's
-sources (the fingerprint compiled.drop_stale_cache keeps) and FORMAT, the CPU and its features,
-llvmlite and Python; and a call only when its arguments have the file's layout. Otherwise
-the caller takes numba's path, which is slower to start and gives the same numbers.
+sources (the fingerprint compiled.drop_stale_cache keeps) and FORMAT, the CPU (its model
+and features) and Python; and a call only when its arguments have the file's layout.
+Otherwise the caller takes numba's path, which is slower to start and gives the same
+numbers. Without a C compiler no file is made, and renders load numba as before.
 
 Entries allocate nothing (the caller passes the output and scratch arrays), so the code
 needs neither numba's runtime nor its helpers: the symbols it imports are the C library's
-and Python's, found in the process, and a few of numba's on the paths that raise a Python
-exception, which rtcli's kernels never take; those are bound to abort() when numba has not
-defined them.
+and Python's, which the process has (`load` checks), and a few of numba's on the paths
+that raise a Python exception, which rtcli's kernels never take. The library is opened
+with lazy binding, so those are never looked up.
 """
 
 from __future__ import annotations
@@ -32,7 +35,11 @@ import ctypes
 import hashlib
 import json
 import os
+import platform
+import shutil
+import subprocess
 import sys
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -42,7 +49,7 @@ from rtcli import variants
 
 ENABLED = os.environ.get("RTCLI_MACHINE_CODE", "1") != "0"
 SOURCES = ("variants.py", "core", "shapes", "compiled")     # what the machine code is made of
-FORMAT = 1                              # of the files: a change to how they are made or called adds one
+FORMAT = 2                              # of the files: a change to how they are made or called adds one
 PACKAGE = Path(variants.PACKAGE_DIR)
 ARGUMENTS = 3                           # the C function's: words (int64 *), floats (double *), results (int64 *)
 HELPERS = ("NRT_", "numba_")            # numba's runtime and helpers: their symbols' prefixes
@@ -135,10 +142,24 @@ def sources_digest(package: Path = PACKAGE) -> str:
     return digest.hexdigest()
 
 
-def _key(ll) -> dict:
-    import llvmlite
-    return {"format": FORMAT, "sources": _digest(), "cpu": ll.get_host_cpu_name(), "features": ll.get_host_cpu_features().flatten(),
-            "llvmlite": llvmlite.__version__, "python": sys.implementation.cache_tag}
+def _key() -> dict:
+    return {"format": FORMAT, "sources": _digest(), "cpu": cpu(), "python": sys.implementation.cache_tag,
+            "platform": sys.platform}
+
+
+def cpu() -> str:
+    """This CPU as machine code cares: its model and feature flags (Linux's /proc/cpuinfo), else
+    what the platform module says."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            first = f.read().split("\n\n")[0]
+        fields = dict(line.split(":", 1) for line in first.splitlines() if ":" in line)
+        wanted = [fields.get(k, "").strip() for k in ("vendor_id", "model name", "flags", "Features", "CPU part")]
+        if any(wanted):
+            return hashlib.sha256("|".join(wanted).encode()).hexdigest()[:32]
+    except OSError:
+        pass
+    return f"{platform.machine()} {platform.processor()}"
 
 
 _digests: list = []
@@ -158,8 +179,14 @@ def folder() -> Path | None:
 
 
 def files(name: str, place: Path) -> tuple[Path, Path]:
-    """The machine code and its description, for the entry `name`."""
-    return place / f"rtcli-{name}.o", place / f"rtcli-{name}.json"
+    """The machine code (a shared library) and its description, for the entry `name`."""
+    return place / f"rtcli-{name}.so", place / f"rtcli-{name}.json"
+
+
+def compiler() -> str | None:
+    """The C compiler that links the shared libraries: $CC, cc, gcc or clang."""
+    found = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    return shutil.which(found) if found else None
 
 
 # --- making a file (needs numba) ---
@@ -167,8 +194,8 @@ def make(name: str, dispatcher, args: tuple, results: int = 0) -> bool:
     """Write the machine code of numba's `dispatcher` (called with `args` once already) wrapped for
     calls with arguments of args' layout; whether it was written. It reaches into numba's
     code library for the object code, so any failure only means there is no file."""
-    place = folder()
-    if not ENABLED or place is None:
+    place, cc = folder(), compiler()
+    if not ENABLED or place is None or cc is None:
         return False
     try:
         import llvmlite.binding as ll
@@ -181,22 +208,36 @@ def make(name: str, dispatcher, args: tuple, results: int = 0) -> bool:
         exec(compile(source, f"<rtcli machine code entry {name}>", "exec"), scope)
         word, number = nt.CPointer(nt.int64), nt.CPointer(nt.float64)
         c = cfunc(nt.void(word, number, word), error_model="numpy")(scope["entry"])
-        library = c._library
-        code = library._codegen._tm.emit_object(library._final_module)
-        module = library._final_module
+        module = c._library._final_module                  # numba's optimised, linked module
+        machine = ll.Target.from_triple(module.triple).create_target_machine(
+            cpu=ll.get_host_cpu_name(), features=ll.get_host_cpu_features().flatten(), opt=3, reloc="pic",
+            codemodel="default")
         imports = sorted({v.name for v in list(module.functions) + list(module.global_variables)
                           if v.is_declaration and not v.name.startswith("llvm.")})
         description = {"symbol": c.native_name, "layout": [layout(a) for a in args], "results": results,
-                       "imports": imports, "key": _key(ll)}
-        code_file, about = files(name, place)
-        for path, data in ((code_file, code), (about, json.dumps(description).encode())):
-            tmp = path.with_name(path.name + f".{os.getpid()}.tmp")
-            tmp.write_bytes(data)
-            os.replace(tmp, path)          # the description last: a reader never sees it before its code
+                       "imports": imports, "key": _key()}
+        library, about = files(name, place)
+        with tempfile.TemporaryDirectory(dir=place) as work:
+            code = Path(work, "entry.o")
+            code.write_bytes(machine.emit_object(module))
+            linked = Path(work, library.name)
+            subprocess.run([cc, "-shared", "-o", str(linked), str(code), *_link_options()], check=True,
+                           capture_output=True, timeout=120)
+            os.replace(linked, library)
+            written = Path(work, about.name)
+            written.write_text(json.dumps(description))
+            os.replace(written, about)          # the description last: a reader never sees it before its code
         _loaded.pop(name, None)
         return True
-    except Exception:                       # another numba's internals, a full disk: numba's path goes on
+    except Exception:                       # another numba's internals, no linker, a full disk: numba's path
         return False
+
+
+def _link_options() -> list[str]:
+    """Unresolved symbols are the process's (Python's, numba's helpers): left to the loader."""
+    if sys.platform == "darwin":
+        return ["-undefined", "dynamic_lookup"]
+    return ["-Wl,-z,lazy"]
 
 
 def _dtypes(layouts: list):
@@ -247,7 +288,6 @@ class Entry:
 
 
 _loaded: dict = {}
-_engine: list = []
 
 
 def load(name: str) -> Entry | None:
@@ -263,52 +303,23 @@ def _read(name: str) -> Entry | None:
     place = folder()
     if place is None:
         return None
-    code_file, about = files(name, place)
+    library, about = files(name, place)
     try:
         description = json.loads(about.read_text())
-        import llvmlite.binding as ll
-        if description["key"] != _key(ll):
+        if description["key"] != _key() or not _present(description["imports"]):
             return None
-        engine = _jit(ll)
-        if not _bind(ll, description["imports"]):
-            return None
-        engine.add_object_file(ll.ObjectFileRef.from_data(code_file.read_bytes()))
-        engine.finalize_object()
-        address = engine.get_function_address(description["symbol"])
-        if not address:
-            return None
-        function = ctypes.CFUNCTYPE(None, *[ctypes.c_void_p] * ARGUMENTS)(address)
+        function = ctypes.CDLL(str(library), mode=os.RTLD_LAZY | os.RTLD_LOCAL)[description["symbol"]]
+        function.restype, function.argtypes = None, [ctypes.c_void_p] * ARGUMENTS
         return Entry(function, description["layout"], int(description["results"]))
-    except Exception:                       # missing, half-written, another llvmlite: numba's path
+    except Exception:                       # missing, half-written, unreadable: numba's path
         return None
 
 
-def _bind(ll, imports: list) -> bool:
-    """Give LLVM the address of each symbol the code imports that it does not know yet: the C
-    library's and Python's from the process (dlsym), numba's HELPERS bound to abort() when numba
-    has not defined them; whether all were found."""
+def _present(imports: list) -> bool:
+    """Whether the process has every symbol the code imports, numba's HELPERS aside."""
     process = ctypes.CDLL(None)
     process.dlsym.restype, process.dlsym.argtypes = ctypes.c_void_p, [ctypes.c_void_p, ctypes.c_char_p]
-    abort = process.dlsym(None, b"abort")
-    for symbol in imports:
-        if ll.address_of_symbol(symbol):
-            continue
-        address = process.dlsym(None, symbol.encode()) or (abort if symbol.startswith(HELPERS) else None)
-        if not address:
-            return False
-        ll.add_symbol(symbol, address)
-    return True
-
-
-def _jit(ll):
-    """The process's one execution engine for machine code files, made at the first load."""
-    if not _engine:
-        ll.initialize_native_target()
-        ll.initialize_native_asmprinter()
-        machine = ll.Target.from_default_triple().create_target_machine(
-            cpu=ll.get_host_cpu_name(), features=ll.get_host_cpu_features().flatten(), opt=3)
-        _engine.append(ll.create_mcjit_compiler(ll.parse_assembly(""), machine))
-    return _engine[0]
+    return all(symbol.startswith(HELPERS) or process.dlsym(None, symbol.encode()) for symbol in imports)
 
 
 def entry(name: str, compiled: Callable, args: tuple) -> Callable:

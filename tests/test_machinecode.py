@@ -94,7 +94,7 @@ def edit_description(place, name, change):
 
 
 @pytest.mark.parametrize("field, value", [("sources", "0" * 64), ("cpu", "another-cpu"), ("format", 0),
-                                          ("llvmlite", "0.0"), ("features", "-avx")])
+                                          ("python", "cpython-27"), ("platform", "win32")])
 def test_a_file_made_for_another_process_is_not_used(small, place, field, value):
     assert machinecode.load("small") is not None
     edit_description(place, "small", lambda d: d["key"].update({field: value}))
@@ -117,7 +117,10 @@ def test_a_missing_or_broken_file_is_not_used(small, place):
     assert machinecode.load("never-made") is None
 
 
-def test_without_a_cache_nothing_is_made(monkeypatch):
+def test_without_a_cache_or_a_c_compiler_nothing_is_made(monkeypatch, place):
+    monkeypatch.setattr(machinecode, "compiler", lambda: None)
+    assert not machinecode.make("small", None, small_args())
+    monkeypatch.undo()
     monkeypatch.setattr(machinecode, "folder", lambda: None)
     monkeypatch.setattr(machinecode, "_loaded", {})
     assert not machinecode.make("small", None, small_args())
@@ -191,13 +194,13 @@ def test_stale_sources_drop_the_files(engine_files, tmp_path):
     copy = tmp_path / "compiled"
     shutil.copytree(folder, copy)
     (copy / fast.STAMP).write_text("stale")
-    found = sorted(p.name for p in copy.glob("rtcli-*.o"))
-    assert found == ["rtcli-levels.o", "rtcli-trace_camera.o"]
+    found = sorted(p.name for p in copy.glob("rtcli-*.so"))
+    assert found == ["rtcli-levels.so", "rtcli-trace_camera.so"]
     old = fast.cache_places
     try:
         fast.cache_places = lambda: [([copy], False)]
         fast.drop_stale_cache()
     finally:
         fast.cache_places = old
-    assert not list(copy.glob("rtcli-*.o")) and not list(copy.glob("rtcli-*.json"))
+    assert not list(copy.glob("rtcli-*.so")) and not list(copy.glob("rtcli-*.json"))
     assert os.path.exists(machinecode.files(fast.ENTRY, folder)[0])      # the real cache untouched

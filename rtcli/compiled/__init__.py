@@ -9,7 +9,7 @@ when numba is installed and the scene holds only what it supports
 (pack.unsupported), else the numpy engine.
 
 The integrator starts from its machine code file (rtcli/machinecode.py) when there is
-one for this process, in about 0.1 s and without numba. Otherwise numba is imported,
+one for this process, at once and without numba. Otherwise numba is imported,
 and the integrator compiled or loaded from numba's on-disk cache, only when a render
 takes this path; that writes the machine code file after a compile (and `rtcli warmup`
 writes it). numba's cache notices when a function's own file changes, not when a
@@ -90,7 +90,7 @@ def _trace_camera():
 
 PACKAGE = Path(variants.PACKAGE_DIR)
 STAMP = "rtcli-compiled.sha256"
-CACHED = ("*.nbi", "*.nbc", "rtcli-*.o", "rtcli-*.json")     # numba's files and the machine code files
+CACHED = ("*.nbi", "*.nbc", "rtcli-*.so", "rtcli-*.json")     # numba's files and the machine code files
 
 
 def cache_places() -> list[tuple[list[Path], bool]]:
