@@ -17,7 +17,8 @@ Two walks of the same tree, through the same slab test (`slab`):
   pairs for the caller's test, which lowers the rays' best t so later levels prune.
 - `walk`, per ray (compiled by numba in the compiled engine, and used by the numpy
   engine for meshes and sets of objects when numba is installed): depth first,
-  nearer child first, with an explicit stack, pruned by the best t so far. It calls
+  nearer child first (entered without testing its box again), with an explicit stack,
+  pruned by the best t so far. It calls
   LEAF(g, entry, ray, t_min, best, shadow, stack, top) on each leaf entry; `walk` is
   specialised for triangles or scene objects by binding LEAF (variants.compiled).
 """
@@ -188,15 +189,20 @@ def walk(g, root, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
     """(t, entry, prim): the nearest hit in (t_min, t_max) among the leaf entries of the tree
     at `root` in g.nodes / g.links / g.perm, by LEAF; entry -1 on a miss. `shadow` is the mode
     (NEAREST, ANY_CASTER: the first hit found will do, NEAREST_CASTER), passed on to LEAF.
-    stack[bottom:] is scratch (a LEAF may walk a tree of its own above)."""
+    stack[bottom:] is scratch (a LEAF may walk a tree of its own above).
+
+    The nearer child met is popped next, untested: its box was just tested against the same
+    best. The farther one is tested again when it is popped, since best may have shrunk
+    meanwhile (a leaf's hit)."""
     ix, iy, iz = reciprocal(dx), reciprocal(dy), reciprocal(dz)
     best, won, prim = t_max, -1, 0
-    stack[bottom], top = root, bottom + 1
+    stack[bottom], top, tested = root, bottom + 1, False      # tested: the top's box, against best as it is
     while top > bottom:
         top -= 1
         node = stack[top]
-        if entry(g.nodes, node, ox, oy, oz, ix, iy, iz, t_min, best) == INF:    # best may have shrunk
+        if not tested and entry(g.nodes, node, ox, oy, oz, ix, iy, iz, t_min, best) == INF:
             continue
+        tested = False
         child = g.links[node, CHILD]
         if child >= 0:                                  # push the farther child first
             near = entry(g.nodes, child, ox, oy, oz, ix, iy, iz, t_min, best)
@@ -210,6 +216,7 @@ def walk(g, root, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
             if near < INF:
                 stack[top] = first
                 top += 1
+                tested = True
             continue
         start = g.links[node, START]
         for j in range(start, start + g.links[node, COUNT]):
