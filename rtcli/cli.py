@@ -446,13 +446,12 @@ def warmup():
     if where is not None:
         click.echo(f"cache: {where} ({where.why})" if where.enabled else f"cache: none ({where.why}); "
                    f"set {variants.CACHE_ENV} to a writable folder")
-    done, files = warm(notes=lambda text: click.echo(f"note: {text}", err=True))
+    done, (files, why) = warm(notes=lambda text: click.echo(f"note: {text}", err=True))
     for what, load in done:
         how = f"compiled in {load.compile_seconds:.1f} s" if load.compile_seconds else "loaded from the cache"
         click.echo(f"{what}: {how}, ready in {load.seconds:.2f} s")
-    click.echo(f"machine code files: {', '.join(files)} in {machinecode.folder()} (renders start without numba)"
-               if files else
-               "machine code files: none (renders load numba; see docs/architecture.md)")
+    click.echo(f"machine code files: {', '.join(files) or 'none'} in {machinecode.folder()}" +
+               (" (renders start without numba)" if files else "") + (f"; not written: {why}" if why else ""))
     if not bytecode():
         click.echo("note: rtcli's folder is read-only: its Python files were not compiled to bytecode", err=True)
     compiled = sum(load.compile_seconds for _, load in done)

@@ -15,27 +15,33 @@ rebuilds the arguments from a flat list of words, so the pixels are the same bit
 The arguments of an entry are arrays, numbers, bools and namedtuples of those (the
 compiled engine's Geometry and Looks). Their `layout` (each leaf's kind, an array's dtype
 and number of dimensions, a namedtuple's fields) is fixed when the file is made; a call
-passes each array as its address and shape (C order), each int and bool as a word and
-each float as a float. A file is used only when its key matches this process: rtcli's
-sources (the fingerprint compiled.drop_stale_cache keeps) and FORMAT, the CPU (its model
-and features) and Python; and a call only when its arguments have the file's layout.
-Otherwise the caller takes numba's path, which is slower to start and gives the same
-numbers. Without a C compiler no file is made, and renders load numba as before.
+passes each array as its address and shape (C-contiguous, aligned arrays only), each int
+and bool as a word and each float as a float. A file is used only when its key matches
+this process: rtcli's sources (the fingerprint compiled.drop_stale_cache keeps) and this
+module's, the CPU (its model and feature flags), numba, llvmlite and Python; and a call
+only when its arguments have the file's layout. Otherwise the caller takes numba's path,
+which is slower to start and gives the same numbers. Without a C compiler no file is
+made, and renders load numba as before.
 
 Entries allocate nothing (the caller passes the output and scratch arrays), so the code
 needs neither numba's runtime nor its helpers: the symbols it imports are the C library's
-and Python's, which the process has (`load` checks), and a few of numba's on the paths
-that raise a Python exception, which rtcli's kernels never take. The library is opened
-with lazy binding, so those are never looked up.
+and Python's, and a few of numba's on the paths that raise a Python exception, which
+rtcli's kernels never take. Those are linked to stubs that say so on stderr and abort(),
+so the library opens with every symbol bound (a missing one means numba's path).
+
+Writing is atomic: the library's name holds a hash of its bytes, and the description
+(.json), replaced last, names it.
 """
 
 from __future__ import annotations
 
 import ctypes
 import hashlib
+import importlib.metadata
 import json
 import os
 import platform
+import shlex
 import shutil
 import subprocess
 import sys
@@ -49,7 +55,6 @@ from rtcli import variants
 
 ENABLED = os.environ.get("RTCLI_MACHINE_CODE", "1") != "0"
 SOURCES = ("variants.py", "core", "shapes", "compiled")     # what the machine code is made of
-FORMAT = 2                              # of the files: a change to how they are made or called adds one
 PACKAGE = Path(variants.PACKAGE_DIR)
 ARGUMENTS = 3                           # the C function's: words (int64 *), floats (double *), results (int64 *)
 HELPERS = ("NRT_", "numba_")            # numba's runtime and helpers: their symbols' prefixes
@@ -57,33 +62,40 @@ HELPERS = ("NRT_", "numba_")            # numba's runtime and helpers: their sym
 
 # --- what an entry's arguments look like ---
 def layout(value) -> list:
-    """The layout of an argument: ["a", dtype, ndim], ["i"], ["b"], ["f"], or ["t", [fields' layouts]]
-    for a namedtuple; TypeError for anything else."""
+    """The layout of an argument: ["a", dtype, ndim], ["i"] (int64), ["b"], ["f"] (float64), or
+    ["t", [fields' layouts]] for a namedtuple; TypeError for anything else (a narrower scalar, a
+    0-d array), which numba would type otherwise."""
     if isinstance(value, np.ndarray) and value.ndim > 0:
         return ["a", value.dtype.str, value.ndim]
     if isinstance(value, tuple) and hasattr(value, "_fields"):
         return ["t", [layout(v) for v in value]]
     if isinstance(value, (bool, np.bool_)):
         return ["b"]
-    if isinstance(value, (int, np.integer)):
+    if type(value) is int or type(value) is np.int64:
         return ["i"]
-    if isinstance(value, (float, np.floating)):
+    if type(value) is float or type(value) is np.float64:
         return ["f"]
     raise TypeError(f"a machine code entry cannot take a {type(value).__name__}")
 
 
-def flatten(value, words: list, floats: list, keep: list) -> None:
-    """Append an argument to the call's words and floats (layout order); `keep` holds the arrays
-    made C-contiguous for the call."""
+def passable(value) -> bool:
+    """Whether every array of an argument can be passed by its address: C-contiguous and aligned
+    (the C function writes where the caller reads)."""
     if isinstance(value, np.ndarray):
-        if not value.flags.c_contiguous:
-            value = np.ascontiguousarray(value)
-            keep.append(value)
+        return value.flags.c_contiguous and value.flags.aligned
+    if isinstance(value, tuple):
+        return all(passable(v) for v in value)
+    return True
+
+
+def flatten(value, words: list, floats: list) -> None:
+    """Append an argument to the call's words and floats, in layout order."""
+    if isinstance(value, np.ndarray):
         words.append(value.ctypes.data)
         words.extend(value.shape)
     elif isinstance(value, tuple):
         for v in value:
-            flatten(v, words, floats, keep)
+            flatten(v, words, floats)
     elif isinstance(value, (float, np.floating)):
         floats.append(float(value))
     else:
@@ -143,31 +155,42 @@ def sources_digest(package: Path = PACKAGE) -> str:
 
 
 def _key() -> dict:
-    return {"format": FORMAT, "sources": _digest(), "cpu": cpu(), "python": sys.implementation.cache_tag,
-            "platform": sys.platform}
+    return {"sources": _digest(), "cpu": cpu(), "numba": _version("numba"), "llvmlite": _version("llvmlite"),
+            "python": sys.implementation.cache_tag, "platform": sys.platform}
 
 
-def cpu() -> str:
-    """This CPU as machine code cares: its model and feature flags (Linux's /proc/cpuinfo), else
-    what the platform module says."""
+def _version(package: str) -> str:
     try:
-        with open("/proc/cpuinfo") as f:
-            first = f.read().split("\n\n")[0]
-        fields = dict(line.split(":", 1) for line in first.splitlines() if ":" in line)
-        wanted = [fields.get(k, "").strip() for k in ("vendor_id", "model name", "flags", "Features", "CPU part")]
-        if any(wanted):
-            return hashlib.sha256("|".join(wanted).encode()).hexdigest()[:32]
-    except OSError:
-        pass
-    return f"{platform.machine()} {platform.processor()}"
+        return importlib.metadata.version(package)
+    except importlib.metadata.PackageNotFoundError:
+        return ""
+
+
+def cpu(cpuinfo: str | None = None) -> str:
+    """This CPU as machine code cares: a hash of its vendor, model and feature flags (Linux's
+    /proc/cpuinfo, or `cpuinfo` given), else the platform module's description."""
+    if cpuinfo is None:
+        try:
+            with open("/proc/cpuinfo") as f:
+                cpuinfo = f.read()
+        except OSError:
+            cpuinfo = ""
+    first = cpuinfo.split("\n\n")[0]
+    fields = {k.strip(): v.strip() for k, _, v in (line.partition(":") for line in first.splitlines())}
+    wanted = [fields.get(k, "") for k in ("vendor_id", "model name", "flags", "CPU implementer", "CPU part",
+                                          "Features")]
+    if any(wanted[1:]):
+        return "cpuinfo " + hashlib.sha256("|".join(wanted).encode()).hexdigest()[:32]
+    return f"{platform.machine()} {platform.processor()} {platform.platform()}"
 
 
 _digests: list = []
 
 
 def _digest() -> str:
+    """The sources' digest and this module's, once a process."""
     if not _digests:
-        _digests.append(sources_digest())
+        _digests.append(sources_digest() + hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:16])
     return _digests[0]
 
 
@@ -178,25 +201,33 @@ def folder() -> Path | None:
     return Path(where.folders()[variants.COMPILED_DIRS.index("compiled")]) if where.enabled else None
 
 
-def files(name: str, place: Path) -> tuple[Path, Path]:
-    """The machine code (a shared library) and its description, for the entry `name`."""
-    return place / f"rtcli-{name}.so", place / f"rtcli-{name}.json"
+def description_file(name: str, place: Path) -> Path:
+    """The description of the entry `name`: its key, layout, symbol and library file."""
+    return place / f"rtcli-{name}.json"
 
 
-def compiler() -> str | None:
-    """The C compiler that links the shared libraries: $CC, cc, gcc or clang."""
-    found = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
-    return shutil.which(found) if found else None
+def compiler() -> list[str] | None:
+    """The C compiler command that links the shared libraries: $CC (may hold options), else cc,
+    gcc or clang."""
+    given = shlex.split(os.environ.get("CC", ""))
+    if given:
+        return [shutil.which(given[0]) or given[0], *given[1:]]
+    found = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    return [found] if found else None
 
 
 # --- making a file (needs numba) ---
-def make(name: str, dispatcher, args: tuple, results: int = 0) -> bool:
+def make(name: str, dispatcher, args: tuple, results: int = 0) -> str | None:
     """Write the machine code of numba's `dispatcher` (called with `args` once already) wrapped for
-    calls with arguments of args' layout; whether it was written. It reaches into numba's
-    code library for the object code, so any failure only means there is no file."""
+    calls with arguments of args' layout; None when written, else why not. It reaches into
+    numba's code library for the optimised module, so a failure only means there is no file."""
     place, cc = folder(), compiler()
-    if not ENABLED or place is None or cc is None:
-        return False
+    if not ENABLED:
+        return "RTCLI_MACHINE_CODE=0"
+    if place is None:
+        return "no cache folder"
+    if cc is None:
+        return "no C compiler (cc) to link them"
     try:
         import llvmlite.binding as ll
         from numba import carray, cfunc
@@ -212,32 +243,55 @@ def make(name: str, dispatcher, args: tuple, results: int = 0) -> bool:
         machine = ll.Target.from_triple(module.triple).create_target_machine(
             cpu=ll.get_host_cpu_name(), features=ll.get_host_cpu_features().flatten(), opt=3, reloc="pic",
             codemodel="default")
-        imports = sorted({v.name for v in list(module.functions) + list(module.global_variables)
-                          if v.is_declaration and not v.name.startswith("llvm.")})
-        description = {"symbol": c.native_name, "layout": [layout(a) for a in args], "results": results,
-                       "imports": imports, "key": _key()}
-        library, about = files(name, place)
+        helpers = sorted({v.name for v in module.functions if v.is_declaration and v.name.startswith(HELPERS)})
         with tempfile.TemporaryDirectory(dir=place) as work:
-            code = Path(work, "entry.o")
-            code.write_bytes(machine.emit_object(module))
-            linked = Path(work, library.name)
-            subprocess.run([cc, "-shared", "-o", str(linked), str(code), *_link_options()], check=True,
+            objects = [Path(work, "entry.o"), Path(work, "stubs.o")]
+            objects[0].write_bytes(machine.emit_object(module))
+            objects[1].write_bytes(machine.emit_object(ll.parse_assembly(_stubs(helpers, module.triple))))
+            linked = Path(work, "linked.so")
+            subprocess.run([*cc, "-shared", "-o", str(linked), *map(str, objects), *_link_options()], check=True,
                            capture_output=True, timeout=120)
+            code = linked.read_bytes()
+            library = place / f"rtcli-{name}-{hashlib.sha256(code).hexdigest()[:16]}.so"
             os.replace(linked, library)
-            written = Path(work, about.name)
+            description = {"symbol": c.native_name, "layout": [layout(a) for a in args], "results": results,
+                           "library": library.name, "key": _key()}
+            written = Path(work, "description.json")
             written.write_text(json.dumps(description))
-            os.replace(written, about)          # the description last: a reader never sees it before its code
+            os.replace(written, description_file(name, place))      # the commit: it names the library
+        for old in place.glob(f"rtcli-{name}-*.so"):
+            if old != library:
+                old.unlink(missing_ok=True)       # a process that opened it keeps its mapping
         _loaded.pop(name, None)
-        return True
-    except Exception:                       # another numba's internals, no linker, a full disk: numba's path
-        return False
+        return None
+    except subprocess.CalledProcessError as e:
+        return f"the C compiler failed: {(e.stderr or b'').decode(errors='replace').strip()[:200]}"
+    except Exception as e:                  # another numba's internals, a full disk: numba's path
+        return f"{type(e).__name__}: {e}"
+
+
+def _stubs(names: list[str], triple: str) -> str:
+    """LLVM IR defining numba's helper functions `names` as: say on stderr that the machine code
+    took a path rtcli's kernels never take, then abort()."""
+    text = (b"rtcli: the compiled engine's machine code reached numba's error handling; "
+            b"run with RTCLI_MACHINE_CODE=0 to use numba itself\n")
+    escaped = "".join(chr(b) if 32 <= b < 127 and b not in (34, 92) else f"\\{b:02X}" for b in text)
+    lines = [f'target triple = "{triple}"',
+             f'@rtcli_message = private constant [{len(text)} x i8] c"{escaped}"',
+             "declare i64 @write(i32, i8*, i64)", "declare void @abort()"]
+    for name in names:
+        lines += [f'define void @"{name}"() {{',
+                  f"  %m = getelementptr [{len(text)} x i8], [{len(text)} x i8]* @rtcli_message, i64 0, i64 0",
+                  f"  %w = call i64 @write(i32 2, i8* %m, i64 {len(text)})",
+                  "  call void @abort()", "  unreachable", "}"]
+    return "\n".join(lines) + "\n"
 
 
 def _link_options() -> list[str]:
-    """Unresolved symbols are the process's (Python's, numba's helpers): left to the loader."""
+    """The C library's math, and Python's symbols left to the process that opens the library."""
     if sys.platform == "darwin":
-        return ["-undefined", "dynamic_lookup"]
-    return ["-Wl,-z,lazy"]
+        return ["-lm", "-undefined", "dynamic_lookup"]
+    return ["-lm"]
 
 
 def _dtypes(layouts: list):
@@ -263,7 +317,7 @@ def _pointer():
     return pointer
 
 
-# --- loading and calling (llvmlite only) ---
+# --- loading and calling (ctypes only) ---
 class Entry:
     """A loaded entry point: call it as the numba function, with arguments of its layout."""
 
@@ -271,16 +325,17 @@ class Entry:
         self.function, self.layouts, self.results = function, layouts, results
 
     def fits(self, args: tuple) -> bool:
-        """Whether args have the layout the machine code was made for."""
+        """Whether args have the layout the machine code was made for, and arrays it can be given
+        by address (passable)."""
         try:
-            return [layout(a) for a in args] == self.layouts
+            return [layout(a) for a in args] == self.layouts and all(passable(a) for a in args)
         except TypeError:
             return False
 
     def __call__(self, *args):
-        words, floats, keep = [], [], []
+        words, floats = [], []
         for a in args:
-            flatten(a, words, floats, keep)
+            flatten(a, words, floats)
         w, f = np.array(words or [0], dtype=np.int64), np.array(floats or [0.0])
         r = np.zeros(max(self.results, 1), dtype=np.int64)
         self.function(w.ctypes.data, f.ctypes.data, r.ctypes.data)
@@ -303,23 +358,16 @@ def _read(name: str) -> Entry | None:
     place = folder()
     if place is None:
         return None
-    library, about = files(name, place)
     try:
-        description = json.loads(about.read_text())
-        if description["key"] != _key() or not _present(description["imports"]):
+        description = json.loads(description_file(name, place).read_text())
+        if description["key"] != _key():
             return None
-        function = ctypes.CDLL(str(library), mode=os.RTLD_LAZY | os.RTLD_LOCAL)[description["symbol"]]
+        library = place / Path(description["library"]).name
+        function = ctypes.CDLL(str(library), mode=os.RTLD_NOW | os.RTLD_LOCAL)[description["symbol"]]
         function.restype, function.argtypes = None, [ctypes.c_void_p] * ARGUMENTS
         return Entry(function, description["layout"], int(description["results"]))
-    except Exception:                       # missing, half-written, unreadable: numba's path
+    except Exception:                       # missing, unreadable, a symbol not found: numba's path
         return None
-
-
-def _present(imports: list) -> bool:
-    """Whether the process has every symbol the code imports, numba's HELPERS aside."""
-    process = ctypes.CDLL(None)
-    process.dlsym.restype, process.dlsym.argtypes = ctypes.c_void_p, [ctypes.c_void_p, ctypes.c_char_p]
-    return all(symbol.startswith(HELPERS) or process.dlsym(None, symbol.encode()) for symbol in imports)
 
 
 def entry(name: str, compiled: Callable, args: tuple) -> Callable:

@@ -52,7 +52,7 @@ def small(place):
     body = njit(small_body)
     args = small_args()
     body(*args)
-    assert machinecode.make("small", body, args, results=2)
+    assert machinecode.make("small", body, args, results=2) is None
     return body
 
 
@@ -66,12 +66,16 @@ def test_a_file_gives_the_numbers_numba_gives(small):
     assert np.array_equal(out, reference) and out[1] == 1 * 2.5 + 1.5 + 1.0
 
 
-def test_arrays_are_passed_in_c_order(small):
+def test_arrays_that_cannot_be_passed_by_address_do_not_fit(small):
+    """The C function writes where the caller reads: a strided or misaligned array (which would
+    need a copy) goes to numba instead."""
     entry = machinecode.load("small")
-    values = np.arange(8.0)[::2]                       # not contiguous: passed as a contiguous copy
-    out = np.zeros(4)
-    entry(Pair(values, 1.0), out, 0, 0.0, False)
-    assert np.array_equal(out, values)
+    pair, out, k, x, flag = small_args()
+    strided = np.zeros(8)[::2]
+    assert not entry.fits((pair, strided, k, x, flag))
+    assert not entry.fits((Pair(np.arange(8.0)[::2], 2.5), out, k, x, flag))
+    assert machinecode.entry("small", lambda: "numba's", (pair, strided, k, x, flag)) == "numba's"
+    assert entry.fits((pair, out, k, x, flag))
 
 
 def test_arguments_of_another_layout_do_not_fit(small):
@@ -80,34 +84,54 @@ def test_arguments_of_another_layout_do_not_fit(small):
     assert not entry.fits((pair, out, k, 1, flag))               # an int where a float was
     assert not entry.fits((pair, out.reshape(2, 2), k, x, flag))  # two dimensions
     assert not entry.fits((pair, out.astype(np.float32), k, x, flag))
+    assert not entry.fits((pair, out, np.int32(k), x, flag))        # numba would type it int32
+    assert not entry.fits((pair, out, k, np.float32(x), flag))
     assert not entry.fits((pair, out, k, x))
     assert machinecode.entry("small", lambda: "numba's", (pair, out, k, 1, flag)) == "numba's"
     assert machinecode.entry("small", lambda: "numba's", (pair, out, k, x, flag)) is entry
 
 
 def edit_description(place, name, change):
-    about = machinecode.files(name, place)[1]
+    about = machinecode.description_file(name, place)
     description = json.loads(about.read_text())
     change(description)
     about.write_text(json.dumps(description))
     machinecode._loaded.clear()
 
 
-@pytest.mark.parametrize("field, value", [("sources", "0" * 64), ("cpu", "another-cpu"), ("format", 0),
-                                          ("python", "cpython-27"), ("platform", "win32")])
+@pytest.mark.parametrize("field, value", [("sources", "0" * 64), ("cpu", "another-cpu"), ("numba", "0.1"),
+                                          ("llvmlite", "0.1"), ("python", "cpython-27"), ("platform", "win32")])
 def test_a_file_made_for_another_process_is_not_used(small, place, field, value):
     assert machinecode.load("small") is not None
     edit_description(place, "small", lambda d: d["key"].update({field: value}))
     assert machinecode.load("small") is None
 
 
-def test_a_file_whose_code_imports_a_missing_symbol_is_not_used(small, place):
-    edit_description(place, "small", lambda d: d["imports"].append("rtcli_no_such_symbol"))
+def test_the_cpu_is_told_by_its_model_and_flags():
+    info = "processor\t: 0\nvendor_id\t: AuthenticAMD\nmodel name\t: AMD EPYC 9B14\nflags\t\t: fpu sse2 avx2{}\n\n" \
+           "processor\t: 1\n"
+    plain, wide = machinecode.cpu(info.format("")), machinecode.cpu(info.format(" avx512f"))
+    assert plain.startswith("cpuinfo ") and plain != wide                 # another CPU: another key
+    assert machinecode.cpu(info.format("")) == plain
+    if os.path.exists("/proc/cpuinfo"):
+        assert machinecode.cpu().startswith("cpuinfo ")                    # read, not the fallback
+
+
+def test_a_library_with_a_symbol_the_process_lacks_is_not_used(small, place, tmp_path):
+    """Opened with every symbol bound: one the process does not have means numba's path."""
+    cc = machinecode.compiler()
+    source = tmp_path / "lacks.c"
+    source.write_text("extern void rtcli_no_such_symbol(void);\nvoid lacks(void) { rtcli_no_such_symbol(); }\n")
+    library = place / "rtcli-small-lacks.so"
+    subprocess.run([*cc, "-shared", "-fPIC", "-o", str(library), str(source)], check=True)
+    edit_description(place, "small", lambda d: d.update(library=library.name, symbol="lacks"))
     assert machinecode.load("small") is None
 
 
 def test_a_missing_or_broken_file_is_not_used(small, place):
-    code, about = machinecode.files("small", place)
+    about = machinecode.description_file("small", place)
+    edit_description(place, "small", lambda d: d.update(library="rtcli-small-0000.so"))   # a pair half written
+    assert machinecode.load("small") is None
     about.write_text("{")
     machinecode._loaded.clear()
     assert machinecode.load("small") is None
@@ -117,14 +141,68 @@ def test_a_missing_or_broken_file_is_not_used(small, place):
     assert machinecode.load("never-made") is None
 
 
-def test_without_a_cache_or_a_c_compiler_nothing_is_made(monkeypatch, place):
+def test_without_a_cache_a_c_compiler_or_the_switch_nothing_is_made(monkeypatch, place):
+    from numba import njit
+    body = njit(small_body)
+    body(*small_args())
+    monkeypatch.setenv("CC", "false")
+    assert machinecode.make("small", body, small_args(), results=2).startswith("the C compiler failed")
     monkeypatch.setattr(machinecode, "compiler", lambda: None)
-    assert not machinecode.make("small", None, small_args())
-    monkeypatch.undo()
-    monkeypatch.setattr(machinecode, "folder", lambda: None)
-    monkeypatch.setattr(machinecode, "_loaded", {})
-    assert not machinecode.make("small", None, small_args())
+    assert machinecode.make("small", body, small_args(), results=2) == "no C compiler (cc) to link them"
+    monkeypatch.setattr(machinecode, "ENABLED", False)
+    assert machinecode.make("small", body, small_args(), results=2) == "RTCLI_MACHINE_CODE=0"
     assert machinecode.load("small") is None
+    monkeypatch.setattr(machinecode, "ENABLED", True)
+    monkeypatch.setattr(machinecode, "folder", lambda: None)
+    assert machinecode.make("small", body, small_args(), results=2) == "no cache folder"
+    assert machinecode.load("small") is None
+    assert not list(place.iterdir())                                   # nothing left behind
+
+
+def test_a_second_file_replaces_the_first_whole(small, place):
+    """The library's name holds its hash and the description names it: writing again leaves one
+    consistent pair, and a process that opened the old one keeps it."""
+    first = machinecode.load("small")
+    assert machinecode.make("small", small, small_args(), results=2) is None
+    libraries = list(place.glob("rtcli-small-*.so"))
+    assert len(libraries) == 1 and json.loads(machinecode.description_file("small", place).read_text())[
+        "library"] == libraries[0].name
+    assert machinecode.load("small")(*small_args()) == (4, 4) and first(*small_args()) == (4, 4)
+
+
+ERROR_PATH = """
+import sys
+import numpy as np
+from numba import njit
+from rtcli import machinecode
+sys.path.insert(0, {here!r})
+from test_machinecode import Pair
+
+@njit(error_model="numpy")
+def raising(pair, out, k, x, flag):
+    if k > 5:
+        raise ValueError("a path rtcli's kernels never take")
+    out[0] = x
+    return 0, 0
+
+machinecode.folder = lambda: __import__("pathlib").Path({place!r})
+args = (Pair(np.arange(4.0), 1.0), np.zeros(4), 1, 0.5, True)
+raising(*args)
+assert machinecode.make("raising", raising, args, results=2) is None
+del sys.modules["numba"]
+entry = machinecode.load("raising")
+entry(*args)
+print("fine", flush=True)
+entry(args[0], args[1], 9, 0.5, True)
+print("not reached", flush=True)
+"""
+
+
+def test_the_error_path_says_so_and_stops_the_process(place):
+    code = ERROR_PATH.format(here=str(Path(__file__).parent), place=str(place))
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert done.stdout.split() == ["fine"], done.stderr
+    assert done.returncode != 0 and "RTCLI_MACHINE_CODE=0" in done.stderr
 
 
 def test_the_wrapper_rebuilds_each_kind_of_argument():
@@ -144,8 +222,8 @@ def engine_files():
         pytest.skip("no cache folder")
     from rtcli.compiled.warmup import _scenes, machine_code
     machinecode._loaded.clear()
-    made = machine_code(fast.choose(_scenes()[0], "compiled", notes=lambda text: None))
-    assert made == [fast.ENTRY, bvh_build.LEVELS], "numba's code library could not be written out"
+    made, why = machine_code(fast.choose(_scenes()[0], "compiled", notes=lambda text: None))
+    assert made == [fast.ENTRY, bvh_build.LEVELS], why
     return made
 
 
@@ -194,8 +272,8 @@ def test_stale_sources_drop_the_files(engine_files, tmp_path):
     copy = tmp_path / "compiled"
     shutil.copytree(folder, copy)
     (copy / fast.STAMP).write_text("stale")
-    found = sorted(p.name for p in copy.glob("rtcli-*.so"))
-    assert found == ["rtcli-levels.so", "rtcli-trace_camera.so"]
+    found = sorted(p.name.rsplit("-", 1)[0] for p in copy.glob("rtcli-*.so"))
+    assert found == ["rtcli-levels", "rtcli-trace_camera"]
     old = fast.cache_places
     try:
         fast.cache_places = lambda: [([copy], False)]
@@ -203,4 +281,4 @@ def test_stale_sources_drop_the_files(engine_files, tmp_path):
     finally:
         fast.cache_places = old
     assert not list(copy.glob("rtcli-*.so")) and not list(copy.glob("rtcli-*.json"))
-    assert os.path.exists(machinecode.files(fast.ENTRY, folder)[0])      # the real cache untouched
+    assert machinecode.description_file(fast.ENTRY, folder).exists()     # the real cache untouched

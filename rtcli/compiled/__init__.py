@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from rtcli import machinecode, variants
-from rtcli.compiled.loading import Load, cached, ready
+from rtcli.compiled.loading import Load, cached, ready, say
 from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
@@ -61,11 +61,18 @@ class Compiled:
         if self.entry is not None and self.entry.fits(args):
             self.load = Load(time.perf_counter() - start)
             return
-        self.entry = None
+        self.entry, why = None, _import_integrator()
+        if why:
+            raise RtcliError(why)
         self.load = ready([_trace_camera()], lambda: _trace_camera()(*args), "the render engine", "about a minute",
                           notes, start)     # no ray: just the machine code
         if self.load.compile_seconds:                   # so that later processes start without numba
-            machinecode.make(ENTRY, _trace_camera(), args)
+            began = time.perf_counter()
+            why = machinecode.make(ENTRY, _trace_camera(), args)
+            spent = time.perf_counter() - began
+            self.load += Load(spent, spent)
+            (notes or say)(f"machine code file written in {spent:.1f} s: later renders start without numba" if
+                           why is None else f"no machine code file ({why}): later renders load numba")
 
     def _args(self, cam_row, x, y, nc, nr, counts, out) -> tuple:
         return self.geometry, self.looks, cam_row, x, y, nc, nr, counts, self.stack, out, self.frames
@@ -151,7 +158,12 @@ def _load() -> str | None:
         drop_stale_cache()
         _cache_checked = True
     if machinecode.load(ENTRY) is not None:
-        return None
+        return None                 # numba is imported only if a scene's arguments do not fit the file
+    return _import_integrator()
+
+
+def _import_integrator() -> str | None:
+    """Import numba and the compiled integrator; why not, if they cannot be."""
     try:
         import rtcli.compiled.integrator  # noqa: F401
     except ImportError as e:
@@ -190,7 +202,10 @@ def choose(scene, engine: str, rays: int = AUTO_RAYS, bvh: bool = True, notes=No
     shape = unsupported(scene)
     why = f"it does not handle {shape} (--engine numpy does)" if shape else _load()
     if why is None:
-        return Compiled(scene, bvh, notes, start)
+        try:
+            return Compiled(scene, bvh, notes, start)
+        except RtcliError as e:                 # numba was needed after all, and cannot be loaded
+            why = str(e)
     if engine == "compiled":
         raise RtcliError(f"--engine compiled cannot render this scene: {why}")
     return None

@@ -38,10 +38,10 @@ def _scenes():
             Scene(camera, [mesh, floor], materials, lights, eye=np.array([0.0, 2, 8])))
 
 
-def warmup(notes=None) -> tuple[list[tuple[str, Load]], list[str]]:
+def warmup(notes=None) -> tuple[list[tuple[str, Load]], tuple[list[str], str | None]]:
     """Load or compile the machine code of every compiled entry point: (what, how long) for the
-    render engine and the numpy engine's walks, and the entries with a machine code file
-    (machine_code). `notes` hears when one compiles (default: stderr). RtcliError when numba
+    render engine and the numpy engine's walks, and the entries with a machine code file and why
+    one is missing (machine_code). `notes` hears when one compiles (default: stderr). RtcliError when numba
     cannot be loaded."""
     from rtcli import compiled, wavefront
     from rtcli.errors import RtcliError
@@ -59,21 +59,22 @@ def warmup(notes=None) -> tuple[list[tuple[str, Load]], list[str]]:
     return [("the render engine (compiled)", engine.load), (wavefront.WALKS, walks)], machine_code(engine)
 
 
-def machine_code(engine) -> list[str]:
-    """Write the machine code files (rtcli/machinecode.py) of the integrator, unless `engine` (a
-    Compiled) was loaded from its file, and of the BVH build, unless its file is at hand; the
-    entries that have a usable file afterwards."""
+def machine_code(engine) -> tuple[list[str], str | None]:
+    """Write the machine code files (rtcli/machinecode.py) of the integrator and of the BVH build,
+    unless they are at hand and fit (`engine`: a Compiled, whose arguments the file takes): the
+    entries that have a usable file afterwards, and why one could not be written (or None)."""
     from rtcli.compiled import ENTRY, _trace_camera
     from rtcli.core.bvh_build import LEVELS, levels, levels_args
-    if engine.entry is None:
-        machinecode.make(ENTRY, _trace_camera(), engine.empty_call)
+    why, found = None, machinecode.load(ENTRY)
+    if found is None or not found.fits(engine.empty_call):
+        why = machinecode.make(ENTRY, _trace_camera(), engine.empty_call)
     if machinecode.load(LEVELS) is None:
         lo = np.random.default_rng(0).random((64, 3))
         args = levels_args(lo, lo + 0.1, 2, 12)
         run = variants.compiled(levels)
         run(*args)
-        machinecode.make(LEVELS, run, args, results=2)
-    return [name for name in (ENTRY, LEVELS) if machinecode.load(name) is not None]
+        why = machinecode.make(LEVELS, run, args, results=2) or why
+    return [name for name in (ENTRY, LEVELS) if machinecode.load(name) is not None], why
 
 
 def bytecode() -> bool:
