@@ -41,8 +41,12 @@ def warm():
 
 
 def rtcli(*args, env=None, cwd=ROOT):
-    """`python -m rtcli ARGS` in a process of its own: (exit code, stdout, stderr)."""
+    """`python -m rtcli ARGS` in a process of its own: (exit code, stdout, stderr). In a cache of
+    its own (env) it writes no machine code files (tests/test_machinecode.py has those): the
+    tests here are about numba's cache, and each file takes seconds to write."""
     environment = {k: v for k, v in os.environ.items() if k not in (variants.CACHE_ENV, "NUMBA_CACHE_DIR")}
+    if env:
+        environment["RTCLI_MACHINE_CODE"] = "0"
     environment.update(env or {})
     done = subprocess.run([sys.executable, "-m", "rtcli", *args], capture_output=True, text=True, cwd=cwd,
                           env=environment, timeout=900)
@@ -158,7 +162,7 @@ def test_numba_writes_to_the_per_user_cache_when_the_sources_are_read_only(warm,
     """)
     env = {k: v for k, v in os.environ.items() if k not in (variants.CACHE_ENV, "NUMBA_CACHE_DIR")}
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=900,
-                          env={**env, "XDG_CACHE_HOME": str(user), "HOME": str(tmp_path)})
+                          env={**env, "XDG_CACHE_HOME": str(user), "HOME": str(tmp_path), "RTCLI_MACHINE_CODE": "0"})
     assert done.returncode == 0, done.stderr
     assert f"cache: {cache} (the per-user cache: rtcli's folder is read-only)" in done.stdout
     assert done.stderr.startswith(f"note: compiling the render engine, once (about a minute); cached in {cache}")
