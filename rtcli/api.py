@@ -86,8 +86,7 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
     job = Job(w, h, block_size, tile=tile, gamma=gamma, engine=engine, bvh=bvh, linear=linear)
     with scene.model.settings.overridden(samples, max_depth) as s:
         pixels, counts, seconds = _run(scene, job, workers, progress, notes)
-        stats = RenderStats(w, h, s.samples, counts.engine, counts.primary, counts.shadow, counts.reflected,
-                            counts.refracted, seconds, counts.load_seconds, counts.compile_seconds)
+        stats = RenderStats.of(w, h, s.samples, counts, seconds)
     image = ImageArray(pixels, stats, scene.inputs)
     if output is not None:
         image.save(os.fspath(output))
@@ -109,8 +108,7 @@ def signature(scene: Scene | Source, *, width: int | None = None, height: int | 
     from rtcli.render import Job
     w, h, _ = image_size(scene.model, width, height)
     ids, counts, seconds = _run(scene, Job(w, h, block_size, signature=True), workers, None, None)
-    image = ImageArray(ids, RenderStats(w, h, 1, "numpy", counts.primary, 0, 0, 0, seconds, counts.load_seconds,
-                                        counts.compile_seconds), scene.inputs)
+    image = ImageArray(ids, RenderStats.of(w, h, 1, counts, seconds), scene.inputs)
     if output is not None:
         image.save(os.fspath(output))
     return image

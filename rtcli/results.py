@@ -35,6 +35,15 @@ class RenderStats:
     load_seconds: float = 0.0        # the compiled code's start-up: numba imported, machine code loaded or compiled
     compile_seconds: float = 0.0     # of which compiling (0 when the code came from numba's cache)
 
+    @classmethod
+    def of(cls, width: int, height: int, samples: int, counts, seconds: float,
+           start_up: bool = True) -> "RenderStats":
+        """The stats of a render of width x height at samples x samples from its counts (a
+        rtcli.stats.Stats: rays by kind, the engine, its start-up unless `start_up` is False)."""
+        load = (counts.load_seconds, counts.compile_seconds) if start_up else (0.0, 0.0)
+        return cls(width, height, samples, counts.engine or "none", counts.primary, counts.shadow, counts.reflected,
+                   counts.refracted, seconds, *load)
+
     @property
     def total(self) -> int:
         return self.primary + self.shadow + self.reflected + self.refracted

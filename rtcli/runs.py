@@ -46,8 +46,8 @@ def on_cluster(loaded, scene, where, changes: dict, width, height, block_size, p
     start = time.perf_counter()
     pixels, counts = render_image(loaded, job, 1, progress, where, overrides(**changes))
     s = scene.model.settings
-    stats = RenderStats(job.width, job.height, 1 if job.signature else s.samples, counts.engine, counts.primary,
-                        counts.shadow, counts.reflected, counts.refracted, time.perf_counter() - start)
+    stats = RenderStats.of(job.width, job.height, 1 if job.signature else s.samples, counts,
+                           time.perf_counter() - start, start_up=False)
     return ImageArray(pixels, stats, scene.inputs)
 
 
@@ -87,8 +87,8 @@ def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: 
                                        show, where)
     if not stats:
         return
-    done = RenderStats(job.width, job.height, scene.settings.samples, counts.engine or "none", counts.primary,
-                       counts.shadow, counts.reflected, counts.refracted, time.perf_counter() - rendering)
+    done = RenderStats.of(job.width, job.height, scene.settings.samples, counts, time.perf_counter() - rendering,
+                          start_up=False)
     seconds = time.perf_counter() - start
     if stats == "json":
         click.echo(json.dumps({"scene": scene_file, "frames": todo, **done.as_dict(),
