@@ -222,7 +222,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
             return scene
 
         def render_one(scene, label, out=None):
-            api.image_size(scene.model, width, height, ("--width", "--height"))      # the options' names in errors
+            runs.check_size(scene.model, width, height)
             show = runs.progress_bar(bar, one_line(label))
             if view:
                 image = runs.view(scene, view, width, height, tile, label if folder is not None else None)
@@ -268,7 +268,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     loaded, scene = _load(scene_file, frame, keep=where is not None)
     out = _output(scene_file, output, ".sig.png")
     _check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), scene.inputs)
-    api.image_size(scene.model, width, height, ("--width", "--height"))
+    runs.check_size(scene.model, width, height)
     if where is None:
         ids = api.signature(scene, width=width, height=height, block_size=block_size, workers=workers)
     else:
@@ -301,12 +301,12 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
 def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_samples, as_json, gamma, no_bvh, frame):
     """Explain why pixel (X, Y) has its color: its ray tree, every term of the shading equation
     with its numbers, and the sum at every ray (X from the left, Y from the top, from 0)."""
-    from rtcli import api
+    from rtcli import runs
     from rtcli.explain import explain as explain_pixel
     if sample is not None and all_samples:
         raise click.UsageError("--sample and --all-samples go one at a time")
     _, scene = _load(scene_file, frame)
-    api.image_size(scene.model, width, height, ("--width", "--height"))          # the options' names in errors
+    runs.check_size(scene.model, width, height)
     scene.override(width=width, height=height)
     e = explain_pixel(scene, x, y, samples=samples, max_depth=max_depth, gamma=gamma, bvh=not no_bvh)
     if sample is not None and sample >= e.samples ** 2:

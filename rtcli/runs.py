@@ -16,11 +16,16 @@ from rtcli.outputs import check_outputs
 
 def size(model, width, height) -> tuple[int, int]:
     """The image size of a scene's model (api.image_size with the options' names), its note printed."""
-    from rtcli import api
-    w, h, note = api.image_size(model, width, height, ("--width", "--height"))
+    w, h, note = check_size(model, width, height)
     if note:
         click.echo(f"note: {note}", err=True)
     return w, h
+
+
+def check_size(model, width, height) -> tuple[int, int, str | None]:
+    """api.image_size, its errors naming the options --width and --height."""
+    from rtcli import api
+    return api.image_size(model, width, height, ("--width", "--height"))
 
 
 def progress_bar(enabled: bool, label: str):
