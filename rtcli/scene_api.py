@@ -99,7 +99,7 @@ def load(source: Source, folder: str | None = None, frame: int | None = None, op
     `frame` of an animated scene (default 1); `option` names the frame in messages."""
     from rtcli.scenefile import yamlfile
     from rtcli.scenefile.animation import Animation
-    from rtcli.scenefile.files import recording_inputs
+    from rtcli.scenefile.files import reading_scene
     from rtcli.scenefile.plain import DICT, tree_from_dict
     if isinstance(source, Mapping):
         tree, name = tree_from_dict(dict(source), folder or "."), DICT
@@ -115,7 +115,7 @@ def load(source: Source, folder: str | None = None, frame: int | None = None, op
         return of_loaded(load_file(path, frame, option=option), path)
     else:
         raise TypeError(f"a scene is a path, YAML text or a dict, not {type(source).__name__}")
-    with recording_inputs() as inputs:
+    with reading_scene() as inputs:
         animation = Animation(yamlfile.load_tree(tree))
         k = frame or 1
         check_frame(animation, k, name, option)

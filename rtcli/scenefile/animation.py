@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import bisect
 import difflib
-import gc
 import math
 from dataclasses import dataclass
 
@@ -30,7 +29,7 @@ from rtcli.core.scene import Scene
 from rtcli.errors import SceneError, Where, shown
 from rtcli.scenefile import yamlfile
 from rtcli.scenefile.build import build_scene
-from rtcli.scenefile.files import recording_inputs
+from rtcli.scenefile.files import reading_scene
 from rtcli.scenefile.nodes import MapNode, SeqNode
 from rtcli.scenefile.params import Params, describe, finite_numbers, out_of_range
 from rtcli.scenefile.reuse import Parts, sharing
@@ -318,14 +317,8 @@ def load_animation(path: str) -> tuple[Animation, Scene, list[str]]:
     """The scene file's animation (one frame for a still), its first frame, and the real paths
     of every file read (see build.load_scene_and_inputs). Later frames read no file: shapes
     and textures are shared."""
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
-        with recording_inputs() as inputs:
-            animation = Animation(yamlfile.load(path))
-            first = animation.scene(1)
-    finally:
-        if collecting:
-            gc.enable()
+    with reading_scene() as inputs:
+        animation = Animation(yamlfile.load(path))
+        first = animation.scene(1)
     return animation, first, inputs
 

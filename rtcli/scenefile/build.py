@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import gc
 
 import numpy as np
 
@@ -18,7 +17,7 @@ from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
 from rtcli.errors import SceneError
 from rtcli.scenefile import remarks, yamlfile
-from rtcli.scenefile.files import recording_inputs
+from rtcli.scenefile.files import reading_scene
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
 from rtcli.scenefile.objects import ObjectBuilder, material_from, transform_from
 from rtcli.scenefile.params import Params, as_params, describe
@@ -30,20 +29,10 @@ def load_scene(path: str) -> Scene:
 
 
 def load_scene_and_inputs(path: str) -> tuple[Scene, list[str]]:
-    """The scene, and the real paths of every file it read (scene, includes, meshes, textures).
-
-    The cyclic garbage collector is paused meanwhile: loading makes no cycles, and
-    the collector would otherwise walk the growing tree again and again (a third
-    of the time of a 100,000-object scene).
-    """
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
-        with recording_inputs() as inputs:
-            scene = scene_from_docs(yamlfile.load(path))
-    finally:
-        if collecting:
-            gc.enable()
+    """The scene, and the real paths of every file it read (scene, includes, meshes, textures),
+    read with the garbage collector paused (files.reading_scene)."""
+    with reading_scene() as inputs:
+        scene = scene_from_docs(yamlfile.load(path))
     return scene, inputs
 
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import gc
 import io
 import os
 import stat
@@ -139,6 +140,21 @@ def _record(path: str) -> None:
 def recording_inputs():
     """Collects the real path of every input checked inside the block, in a list."""
     return _set(_read, [])
+
+
+@contextlib.contextmanager
+def reading_scene():
+    """Loading a scene: its inputs recorded (recording_inputs), with the cyclic garbage collector
+    paused. Loading makes no cycles, and the collector would otherwise walk the growing tree
+    again and again (a third of the time of a 100,000-object scene)."""
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        with recording_inputs() as inputs:
+            yield inputs
+    finally:
+        if collecting:
+            gc.enable()
 
 
 def stamp(st: os.stat_result | None):
