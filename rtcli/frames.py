@@ -22,7 +22,7 @@ import numpy as np
 
 from rtcli.errors import RtcliError, shown
 from rtcli.movie import check_size, is_movie, movie_format, write_movie
-from rtcli.render import blank, place, plan
+from rtcli.render import assemble, plan
 from rtcli.render import render as render_tiles  # `from rtcli import render` is the API function
 from rtcli.scenefile.animation import Animation, load_animation
 from rtcli.stats import Stats
@@ -115,18 +115,11 @@ def render_image(loaded: Loaded, job, workers: int, progress=None, where=None, c
     (a cluster.Target, or a Reach)."""
     if where is None:
         return render_tiles(loaded.scene, job, workers, progress)
-    image, stats = blank(job), Stats()
-    tiles, traced = plan(loaded.scene, job)
+    stats, (tiles, traced) = Stats(), plan(loaded.scene, job)
     with _session(where) as session:
         results = session.tiles(loaded.bundle, changes or {}, loaded.frame, job, traced, tiles,
                                 1 if job.signature else loaded.scene.settings.samples)
-        for done, (rows, cols, values, s) in enumerate(results, 1):
-            place(image, job, rows, cols, values)
-            stats.add(s)
-            stats.engine = s.engine
-            if progress:
-                progress(done, len(tiles))
-    return image, stats
+        return assemble(job, len(tiles), results, stats, progress), stats
 
 
 # --- sequences ---

@@ -138,18 +138,27 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None, notes=None) 
     compiled code took to load or compile (load_seconds, compile_seconds); `notes` is told when
     it compiles (default: stderr).
     """
-    image, (tiles, traced) = blank(job), plan(scene, job)
+    tiles, traced = plan(scene, job)
     stats, (engine, load) = Stats(), prepare(scene, job, traced, notes)
     stats.engine = "compiled" if engine else "numpy"            # add() keeps it
     if load:
         stats.load_seconds, stats.compile_seconds = load.seconds, load.compile_seconds
     with contextlib.closing(_map_tiles(scene, engine, job, tiles, workers)) as results:     # stops the pool
-        for done, (rows, cols, values, s) in enumerate(results, 1):
-            place(image, job, rows, cols, values)
-            stats.add(s)
-            if progress:
-                progress(done, len(tiles))
-    return image, stats
+        return assemble(job, len(tiles), results, stats, progress), stats
+
+
+def assemble(job: Job, count: int, results, stats: Stats, progress=None) -> np.ndarray:
+    """The image of `count` tiles' results (rows, cols, values, stats) as they come, their counts
+    added to `stats` (and its engine taken from them when not set); progress(done, count) after
+    each."""
+    image = blank(job)
+    for done, (rows, cols, values, s) in enumerate(results, 1):
+        place(image, job, rows, cols, values)
+        stats.add(s)
+        stats.engine = stats.engine or s.engine
+        if progress:
+            progress(done, count)
+    return image
 
 
 def blank(job: Job) -> np.ndarray:
