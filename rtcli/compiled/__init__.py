@@ -178,10 +178,10 @@ def ready_to_load() -> bool:
     """Whether the compiled integrator's machine code is at hand (its file, numba's cache, or in
     memory), so that starting the engine loads it rather than compiling for a minute: a forecast
     (loading.cached)."""
+    if starts_at_once():
+        return True
     if _load() is not None:
         return False
-    if machinecode.load(ENTRY) is not None:
-        return True
     entry = _trace_camera()
     return bool(entry.signatures) or cached(entry) is True
 
