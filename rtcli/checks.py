@@ -5,7 +5,8 @@ not as meant. Each is located where the scene file gives what it is about:
 
 - a color written as 0-255 values (recorded while loading, scenefile/remarks.py);
 - no lights; no objects;
-- a camera that sees no object: no primary ray of a small image hits one;
+- a camera that sees no object: none lies wholly in view, and no primary ray of a small
+  image hits one;
 - a light inside a closed object that casts full shadows: it lights nothing outside;
 - an object no light reaches: at the nearest point of its box, every light's
   attenuated intensity max(I) / (c0 + c1 r + c2 r^2) is below 1/255 (the 8-bit step),
@@ -19,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.core.scene import Scene
-from rtcli.errors import one_line, shown
+from rtcli.errors import RtcliError, one_line, plural, shown
 from rtcli.scenefile.remarks import Remark, Remarks
 
 SMALL = 64                         # the camera check's signature is SMALL pixels on its long side,
@@ -79,7 +80,8 @@ def _box(bounds) -> str:
 def warnings(scene: Scene, remarks: Remarks) -> list[Remark]:
     """Every warning about the scene, in the order of the checks above."""
     colors = list(dict.fromkeys(remarks.colors))           # a color read twice (an alias) once
-    found = _limited(colors, colors[LISTED].where if len(colors) > LISTED else "", "colors that look like 0-255 values")
+    found = _limited(colors, colors[LISTED].where if len(colors) > LISTED else "",
+                     ("color that looks like 0-255 values", "colors that look like 0-255 values"))
     if not scene.lights:
         found.append(Remark(remarks.lights_key, "no lights: only ambient light and emission show "
                                                 "(a light is {position: [x, y, z]})"))
@@ -88,40 +90,84 @@ def warnings(scene: Scene, remarks: Remarks) -> list[Remark]:
     elif not _camera_sees_something(scene):
         found.append(Remark(remarks.camera, "the camera sees no object: every pixel of a signature render "
                                             "is background (is look_at toward the objects?)"))
-    found += _limited(_lights_inside(scene, remarks), remarks.lights_key, "lights inside closed objects")
+    found += _limited(_lights_inside(scene, remarks), remarks.lights_key,
+                      ("light inside a closed object", "lights inside closed objects"))
     if scene.lights:
-        found += _limited(_out_of_reach(scene), remarks.objects_key, "objects that no light reaches")
+        found += _limited(_out_of_reach(scene), remarks.objects_key,
+                          ("object that no light reaches", "objects that no light reaches"))
     return found
 
 
-def _limited(found: list[Remark], where: str, what: str) -> list[Remark]:
-    """The first LISTED of found, and one line counting the rest."""
+def _limited(found: list[Remark], where: str, what: tuple[str, str]) -> list[Remark]:
+    """The first LISTED of found, and one line counting the rest (`what`: singular and plural)."""
     if len(found) <= LISTED:
         return found
-    return found[:LISTED] + [Remark(where, f"{len(found) - LISTED} more {what} (the first {LISTED} are above)")]
+    n = len(found) - LISTED
+    return found[:LISTED] + [Remark(where, f"{n} more {what[n != 1]} (the first {LISTED} are above)")]
+
+
+def strict_error(found: list[Remark]) -> RtcliError:
+    """--strict's error: the first warning, and how many more there are."""
+    more = f" (and {plural(len(found) - 1, 'more warning')})" if len(found) > 1 else ""
+    return RtcliError(f"{found[0].where}: {found[0].message}{more}")
 
 
 # --- the camera ---
 def _camera_sees_something(scene: Scene) -> bool:
-    """Whether the primary rays through pixel centres, SMALL then LARGER pixels on the image's
-    long side, hit any object (the signature render's test, for any number of objects)."""
+    """Whether the camera sees an object: one lies wholly in view, or a primary ray through a pixel
+    centre, SMALL then LARGER pixels on the image's long side, hits one (the signature render's
+    test). The cheap proofs come first (boxes, then the unbounded objects such as a floor, which
+    every ray is tested against anyway), so a render's check rarely traces the whole scene."""
     from rtcli import wavefront
-    from rtcli.render import camera_rays
-    from rtcli.wavefront.intersect import find_first_hit
     s = scene.settings
+    if _wholly_in_view(scene, scene.camera(s.width, s.height)):
+        return True
+    unbounded = np.flatnonzero(~scene.boxes.bounded)
+    if len(unbounded) and _signature_hits(scene, SMALL, unbounded):
+        return True
     wavefront.prepare(scene)
-    for size in (SMALL, LARGER):
-        scale = min(1.0, size / max(s.width, s.height))
-        w, h = max(1, round(s.width * scale)), max(1, round(s.height * scale))
-        cam = scene.camera(w, h)
-        for rows in np.array_split(np.arange(h), max(1, w * h // 16384)):         # about 16,384 rays at once
-            jj, ii = np.meshgrid(rows + 0.5, np.arange(w) + 0.5, indexing="ij")
-            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-                hits = find_first_hit(scene, camera_rays(cam, ii.ravel(), jj.ravel(), w, h))
-            if np.isfinite(hits.t).any():
-                return True
-        if scale == 1.0:
-            break
+    return any(_signature_hits(scene, size) for size in (SMALL, LARGER)
+               if size == SMALL or max(s.width, s.height) > SMALL)
+
+
+def _wholly_in_view(scene: Scene, cam) -> bool:
+    """Whether a bounded object lies wholly inside the camera's view: its box on the inner side of
+    the four planes through the eye and the image's edges, n . (P - E) > 0 at the box's corner
+    nearest each plane. The ray from the eye through any of its points then meets it or an object
+    before it. A csg is left to the rays: its box may hold nothing (an empty intersection)."""
+    corners = [cam.origin, cam.origin + cam.right, cam.origin + cam.right + cam.down, cam.origin + cam.down]
+    edges = [c - cam.eye for c in corners]
+    centre = sum(edges) / 4
+    boxes = scene.boxes
+    inside = boxes.bounded.copy()
+    for a, b in zip(edges, edges[1:] + edges[:1]):
+        n = np.cross(a, b)
+        n = n if n @ centre >= 0 else -n                     # toward the inside of the view
+        with np.errstate(invalid="ignore"):                  # unbounded objects' boxes are NaN
+            inside &= np.where(n > 0, boxes.lo, boxes.hi) @ n - n @ cam.eye > 0
+    return any(scene.objects[k].kind != "csg" for k in np.flatnonzero(inside))
+
+
+def _signature_hits(scene: Scene, size: int, objects=None) -> bool:
+    """Whether a primary ray through a pixel centre of the image scaled to `size` pixels on its
+    long side (never enlarged) hits an object (of `objects` when given, else any)."""
+    from rtcli.render import camera_rays
+    from rtcli.wavefront.intersect import find_first_hit, nearest_over, no_hits
+    s = scene.settings
+    scale = min(1.0, size / max(s.width, s.height))
+    w, h = max(1, round(s.width * scale)), max(1, round(s.height * scale))
+    cam = scene.camera(w, h)
+    for rows in np.array_split(np.arange(h), max(1, w * h // 16384)):         # about 16,384 rays at once
+        jj, ii = np.meshgrid(rows + 0.5, np.arange(w) + 0.5, indexing="ij")
+        rays = camera_rays(cam, ii.ravel(), jj.ravel(), w, h)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            if objects is None:
+                hits = find_first_hit(scene, rays)
+            else:
+                hits = no_hits(len(rays))
+                nearest_over(scene, objects, rays, 0.0, hits)
+        if np.isfinite(hits.t).any():
+            return True
     return False
 
 

@@ -1,4 +1,5 @@
-"""Errors the library raises; cli.py turns them into one-line messages (exit 2)."""
+"""Errors and warnings the library raises; cli.py turns errors into one-line messages (exit 2),
+and IPython shows them as that one line too (RtcliError._render_traceback_)."""
 
 from __future__ import annotations
 
@@ -37,6 +38,11 @@ def shown(text) -> str:
     return text if _PLAIN.fullmatch(text) else quoted(text)
 
 
+def plural(n: int, word: str, words: str | None = None) -> str:
+    """'1 warning', '2 warnings': a count with its noun (`words` when the plural is not word + s)."""
+    return f"{n} {word if n == 1 else words or word + 's'}"
+
+
 def one_line(message: str) -> str:
     """The message with any line break or other control character escaped: the last
     guard of the rule that every error is one line."""
@@ -53,6 +59,16 @@ class Interrupted(BaseException):
 
 class RtcliError(Exception):
     """Any error meant for the user: bad input, unreadable file, bad option."""
+
+    def _render_traceback_(self) -> list[str]:
+        """What IPython and Jupyter show for this error instead of its traceback (IPython's
+        convention): its one-line message, as the command line prints it (docs/python-api.md)."""
+        return [f"{type(self).__name__}: {one_line(str(self))}"]
+
+
+class RtcliWarning(UserWarning):
+    """A likely mistake in a scene that is not an error (`rtcli validate`'s warnings), raised as a
+    Python warning when the API loads the scene (docs/python-api.md)."""
 
 
 class SceneError(RtcliError):

@@ -188,7 +188,7 @@ def test_strict_makes_the_first_warning_an_error(validate, tmp_path):
     assert result.exit_code == 2 and result.stdout == ""
     assert result.stderr == ("error: s.yaml:3:13: background: [30, 30, 40] looks like 0-255 values, but colors run "
                              'from 0 to 1 here: [0.118, 0.118, 0.157] or "#1e1e28" (write 30.0 if more than 1 is '
-                             "meant) (and 1 more warnings)\n")
+                             "meant) (and 1 more warning)\n")
 
 
 def test_strict_passes_a_scene_without_warnings(validate):
