@@ -88,12 +88,15 @@ def main(debug):
     # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
-def _load(path: str, frame: int | None = None, keep: bool = False, **overrides):
+def _load(path: str, frame: int | None = None, keep: bool = False, lint=None, **overrides):
     """(frames.Loaded, api.Scene) of a scene file at frame `frame` (default 1), with the command
-    line's overrides; `keep`: also the files' bytes, for a cluster."""
+    line's overrides; `keep`: also the files' bytes, for a cluster; `lint` (lint.Lint): what to
+    do with its warnings."""
     from rtcli.frames import load
     from rtcli.scene_api import of_loaded
-    loaded = load(path, frame, keep=keep)
+    loaded = load(path, frame, keep=keep, lint=lint is not None and lint.wanted)
+    if lint is not None:
+        lint.report(loaded.warnings, path, loaded.animation.frames)
     return loaded, of_loaded(loaded, path).override(**overrides)
 
 
@@ -153,7 +156,7 @@ def _cluster(address, file, local):
 @click.option("--tile", type=click.IntRange(1, 4096), default=128, show_default=True,
               help="Tile edge in pixels (memory per worker).")
 @click.option("--gamma", is_flag=True, help="sRGB-encode the output (default: linear).")
-@click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("--quiet", is_flag=True, help="No progress bar, no warnings.")
 @click.option("--progress", is_flag=True, help="Show the progress bar even when stderr is not a terminal.")
 @click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")
 @click.option("--json", "as_json", is_flag=True, help="With --stats: one JSON object per scene, one a line.")
@@ -168,13 +171,15 @@ def _cluster(address, file, local):
 @click.option("--frame", type=click.IntRange(1), metavar="N", help="Render frame N of an animated scene (default 1).")
 @click.option("--movie", metavar="MOVIE.apng", callback=_not_empty,
               help="Also write the frames as an animated PNG (.apng) or GIF (.gif).")
-@click.option("--skip-existing", is_flag=True, help="Leave the frames (or images) already written; render the rest.")
+@click.option("--skip-existing", is_flag=True, help="Leave the frames (or images) already written at the size "
+                                                    "asked for; render the rest.")
+@click.option("--strict", is_flag=True, help="The scene's warnings (as validate prints them) are errors (exit 2).")
 @_cluster_options
 @click.option("--watch", is_flag=True, help="Render again whenever the scene or a file it reads changes; "
                                             "print each render's time; Ctrl-C ends.")
 def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
            gamma, quiet, progress, stats, as_json, engine, no_bvh, view, frame_range, frame, movie, skip_existing,
-           cluster, cluster_file, local_cluster, watch):
+           strict, cluster, cluster_file, local_cluster, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
     from rtcli import api, batch, runs
@@ -204,13 +209,14 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
         raise click.UsageError("--watch renders on this machine: it takes no cluster option")
     where = _cluster(cluster, cluster_file, local_cluster)
     bar = not quiet and (progress or sys.stderr.isatty())
+    lint = runs.lint(quiet, strict, several, watch)
     with where or contextlib.nullcontext():
         if sequence and not several:
             job = dict(width=width, height=height, block_size=block_size, tile=tile, gamma=gamma, engine=engine,
                        bvh=not no_bvh)
             shown_stats = ("json" if as_json else "line") if stats else None
             return runs.render_frames(scene_files[0], output, frame_range, frame, movie, skip_existing, where, job,
-                                  animation.overrides(samples, max_depth), workers, bar, shown_stats)
+                                      animation.overrides(samples, max_depth), workers, bar, shown_stats, lint)
         items, folder = batch.plan(list(scene_files), output, f".{view}.png" if view else ".png")
         if skip_existing:
             items = [item for item in items if not os.path.isfile(item.output)]
@@ -218,7 +224,8 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
         current = {}
 
         def load(path):
-            current["loaded"], scene = _load(path, frame, where is not None, samples=samples, max_depth=max_depth)
+            current["loaded"], scene = _load(path, frame, where is not None, lint, samples=samples,
+                                             max_depth=max_depth)
             return scene
 
         def render_one(scene, label, out=None):
@@ -409,27 +416,20 @@ def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
 def validate(scene_file, list_objects, strict):
     """Parse and check a scene, every frame of an animated one; print a summary, and warnings about
     likely mistakes on stderr. Renders only a small signature (does the camera see anything?)."""
-    from rtcli import checks
+    from rtcli import checks, lint
     from rtcli.frames import load
     from rtcli.scenefile.build import summary
-    from rtcli.scenefile.remarks import recording_remarks
-    with recording_remarks() as remarks:
-        loaded = load(scene_file)
+    loaded = load(scene_file, lint=True)
     frames = loaded.animation.check_all()
-    scene = loaded.scene
-    found = checks.warnings(scene, remarks)
+    scene, found = loaded.scene, loaded.warnings
     if strict and found:
-        more = f" (and {len(found) - 1} more warnings)" if len(found) > 1 else ""
-        raise RtcliError(f"{found[0].where}: {found[0].message}{more}")
+        raise checks.strict_error(found)
     click.echo(f"{shown(scene_file)}: ok: {summary(scene)}{frames}")
     if list_objects:
         for line in checks.object_lines(checks.object_rows(scene)):
             click.echo(line)
-    for remark in found:
-        click.echo(one_line(str(remark)), err=True)
-    if found and loaded.animation.frames > 1:
-        click.echo(f"note: the warnings are about frame 1 of {loaded.animation.frames} (the camera, lights "
-                   "and objects where the animation starts)", err=True)
+    for line in lint.lines(found, scene_file, loaded.animation.frames):
+        click.echo(line, err=True)
 
 
 @main.command()

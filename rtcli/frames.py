@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rtcli import checks
 from rtcli.errors import RtcliError, shown
 from rtcli.movie import check_size, is_movie, movie_format, write_movie
 from rtcli.render import assemble, plan
@@ -34,29 +35,35 @@ PATTERN = re.compile(r"(?:[^%]|%%)*%0?[1-9]?\d*d(?:[^%]|%%)*", re.DOTALL)    # e
 @dataclass
 class Loaded:
     """A scene file read for a render: its animation, the scene of the frame asked for, the real
-    paths of its inputs, and the files' bytes when they go to a cluster (cluster.Bundle)."""
+    paths of its inputs, the files' bytes when they go to a cluster (cluster.Bundle), and the
+    warnings about frame 1 when they were asked for (lint.py)."""
 
     animation: Animation
     scene: object
     frame: int
     inputs: list
     bundle: object = None
+    warnings: list = field(default_factory=list)
 
 
-def load(scene_file: str, frame: int | None = None, keep: bool = False, option: str = "--frame") -> Loaded:
+def load(scene_file: str, frame: int | None = None, keep: bool = False, option: str = "--frame",
+         lint: bool = False) -> Loaded:
     """The scene file with frame `frame` (default 1) built; `keep`: also the files' bytes;
-    `option` names the frame in messages."""
+    `option` names the frame in messages; `lint`: also `rtcli validate`'s warnings (checks.py)."""
     from rtcli.scene_api import check_frame
     from rtcli.scenefile.files import collecting
-    with collecting() if keep else contextlib.nullcontext() as kept:
+    from rtcli.scenefile.remarks import recording_remarks
+    with collecting() if keep else contextlib.nullcontext() as kept, \
+            recording_remarks() if lint else contextlib.nullcontext() as remarks:
         animation, first, inputs = load_animation(scene_file)
+    k = frame or 1
+    check_frame(animation, k, scene_file, option)
+    found = checks.warnings(first, remarks) if lint else []
     bundle = None
     if keep:
         from rtcli.cluster import Bundle
         bundle = Bundle.of(scene_file, kept)
-    k = frame or 1
-    check_frame(animation, k, scene_file, option)
-    return Loaded(animation, first if k == 1 else animation.scene(k), k, inputs, bundle)
+    return Loaded(animation, first if k == 1 else animation.scene(k), k, inputs, bundle, found)
 
 
 def _frames_of(animation: Animation, scene_file: str) -> str:

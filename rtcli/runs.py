@@ -1,6 +1,6 @@
 """How `rtcli render` (and `signature`) carry out what the options ask (README.md, Commands):
-the image size with its note, the progress bar, an animation's frames, a still traced on a
-cluster, a watch, a debug view. cli.py parses the options and calls these.
+the image size with its note, the progress bar, the scene's warnings, an animation's frames, a
+still traced on a cluster, a watch, a debug view. cli.py parses the options and calls these.
 """
 
 from __future__ import annotations
@@ -38,6 +38,27 @@ def progress_bar(enabled: bool, label: str):
     return show
 
 
+def lint(quiet: bool, strict: bool, several: bool, watch: bool):
+    """What render does with a scene's warnings (lint.Lint): printed on stderr (after the time
+    in a watch, as its other lines), hidden by --quiet, errors with --strict."""
+    from rtcli.lint import Lint
+    return Lint(stamped if watch else echo_err, quiet, strict, several)
+
+
+def echo_err(line: str) -> None:
+    click.echo(line, err=True)
+
+
+def stamped(line: str) -> None:
+    """A watch's line on stderr, after the time of day, as its renders' lines."""
+    click.echo(f"{clock()} {line}", err=True)
+
+
+def clock() -> str:
+    """The time of day, HH:MM:SS, that begins a watch's lines."""
+    return time.strftime("%H:%M:%S")
+
+
 def make_job(model, width, height, block_size, **kw):
     from rtcli.render import Job
     return Job(*size(model, width, height), block_size, **kw)
@@ -57,13 +78,15 @@ def on_cluster(loaded, scene, where, changes: dict, width, height, block_size, p
 
 
 def render_frames(scene_file: str, output, frame_range, frame, movie, skip_existing: bool, where, job: dict,
-                   changes: dict, workers, bar: bool, stats) -> None:
+                  changes: dict, workers, bar: bool, stats, lint=None) -> None:
     """An animation's frames to files or movies (frames.py), each file written as its frame is done;
-    `stats`: None, "line" or "json"."""
+    `stats`: None, "line" or "json"; `lint` (lint.Lint): what to do with the scene's warnings."""
     from rtcli import batch
     from rtcli import frames as animation
     start = time.perf_counter()
-    loaded = animation.load(scene_file, None, keep=where is not None)
+    loaded = animation.load(scene_file, None, keep=where is not None, lint=lint is not None and lint.wanted)
+    if lint is not None:
+        lint.report(loaded.warnings, scene_file, loaded.animation.frames)
     seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
     folder = os.path.dirname(os.path.abspath(next(iter(seq.paths.values())))) if seq.paths else None
     made = batch.make_folder(folder)                     # a frame pattern's folder (its parent must exist)
@@ -114,12 +137,12 @@ def watch_scene(item, load, render_one, stats: bool, as_json: bool) -> None:
         start = time.perf_counter()
         image = render_one(load(item.scene), os.path.basename(item.scene), item.output)
         seconds = time.perf_counter() - start
-        click.echo(f"{time.strftime('%H:%M:%S')} rendered {shown(item.output)} "
-                   f"({image.shape[1]}x{image.shape[0]}) in {seconds:.2f} s", err=as_json)
+        click.echo(f"{clock()} rendered {shown(item.output)} ({image.shape[1]}x{image.shape[0]}) "
+                   f"in {seconds:.2f} s", err=as_json)
         for line in batch.stats_lines([(item, image.stats, seconds)], as_json, False) if stats else ():
             click.echo(line)
     click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends", err=as_json)
-    watch(item.scene, once, lambda line: click.echo(line, err=True))
+    watch(item.scene, once, stamped)
 
 
 def view(scene, kind: str, width, height, tile: int, label: str | None):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 
-from rtcli.errors import SOURCES, RtcliError, shown
+from rtcli.errors import SOURCES, RtcliError, one_line, shown
 from rtcli.scenefile.limits import MAX_SCENE_BYTES
 
 Source = str | os.PathLike | Mapping        # what load_scene takes: a path, YAML text or a dict
@@ -24,10 +24,12 @@ RANGES = {"width": (1, 32768), "height": (1, 32768), "samples": (1, 16), "max_de
 class Scene:
     """A loaded scene, ready to render; see rtcli.load_scene."""
 
-    def __init__(self, model, source: str, inputs=(), animation=None, frame: int = 1, overrides=None):
+    def __init__(self, model, source: str, inputs=(), animation=None, frame: int = 1, overrides=None,
+                 warnings=()):
         self.model = model                         # rtcli.core.scene.Scene: what the engines trace
         self.source = source                       # the path, "<string>" or "<dict>"
         self.inputs = tuple(inputs)                # real paths of the files it read
+        self.warnings = tuple(one_line(str(w)) for w in warnings)   # `rtcli validate`'s, about frame 1
         self.frame = frame                         # which frame of an animated scene (1 for a still)
         self._animation = animation                # scenefile.animation.Animation, None for a still
         self._overrides = dict(overrides or {})    # load_scene's width, height, samples, max_depth
@@ -49,7 +51,7 @@ class Scene:
         if frame == self.frame:
             return self
         other = Scene(self._animation.scene(frame), self.source, self.inputs, self._animation, frame,
-                      self._overrides)
+                      self._overrides, self.warnings)
         return other.override(**self._overrides)
 
     def override(self, width: int | None = None, height: int | None = None, samples: int | None = None,
@@ -96,11 +98,22 @@ class Scene:
 
 def load(source: Source, folder: str | None = None, frame: int | None = None, option: str = "frame") -> Scene:
     """The Scene of a path, YAML text or a dict (see rtcli.load_scene for which is which), at frame
-    `frame` of an animated scene (default 1); `option` names the frame in messages."""
+    `frame` of an animated scene (default 1); `option` names the frame in messages. Its warnings
+    (`rtcli validate`'s, about frame 1) are raised as Python warnings (rtcli.RtcliWarning)."""
+    from rtcli import lint
+    scene, found = _load(source, folder, frame, option)
+    lint.warn(found)
+    return scene
+
+
+def _load(source: Source, folder: str | None, frame: int | None, option: str):
+    """The Scene and its warnings (checks.Remark)."""
+    from rtcli import checks
     from rtcli.scenefile import yamlfile
     from rtcli.scenefile.animation import Animation
     from rtcli.scenefile.files import reading_scene
     from rtcli.scenefile.plain import DICT, tree_from_dict
+    from rtcli.scenefile.remarks import recording_remarks
     if isinstance(source, Mapping):
         tree, name = tree_from_dict(dict(source), folder or "."), DICT
     elif is_yaml_text(source):
@@ -112,21 +125,24 @@ def load(source: Source, folder: str | None = None, frame: int | None = None, op
             raise TypeError("folder= is for YAML text and dicts; a scene file's names are relative to its folder")
         from rtcli.frames import load as load_file
         path = os.fspath(source)
-        return of_loaded(load_file(path, frame, option=option), path)
+        loaded = load_file(path, frame, option=option, lint=True)
+        return of_loaded(loaded, path), loaded.warnings
     else:
         raise TypeError(f"a scene is a path, YAML text or a dict, not {type(source).__name__}")
-    with reading_scene() as inputs:
+    with reading_scene() as inputs, recording_remarks() as remarks:
         animation = Animation(yamlfile.load_tree(tree))
         k = frame or 1
         check_frame(animation, k, name, option)
-        model = animation.scene(k)
-    return Scene(model, name, inputs, None if animation.still else animation, k)
+        first = animation.scene(1)
+        model = first if k == 1 else animation.scene(k)
+    found = checks.warnings(first, remarks)
+    return Scene(model, name, inputs, None if animation.still else animation, k, warnings=found), found
 
 
 def of_loaded(loaded, path: str) -> Scene:
     """The Scene of a scene file loaded for the command line (rtcli.frames.Loaded)."""
     animation = None if loaded.animation.still else loaded.animation
-    return Scene(loaded.scene, path, loaded.inputs, animation, loaded.frame)
+    return Scene(loaded.scene, path, loaded.inputs, animation, loaded.frame, warnings=loaded.warnings)
 
 
 def check_frame(animation, k: int, source: str, option: str) -> None:

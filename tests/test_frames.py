@@ -119,7 +119,7 @@ def test_frame_option_errors_are_one_line_and_write_nothing(run, tmp_path, args,
 def test_an_error_in_a_later_frame_stops_before_any_file_is_written(run, tmp_path):
     (tmp_path / "bad.yaml").write_text(
         "animation: {frames: 4}\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\n"
-        "objects: [{sphere: {}, transform: [{scale: {keys: {0: 1, 0.125: 0}}}]}]\n")
+        "objects: [{sphere: {}, transform: [{scale: {keys: {0: 1, 0.125: 0}}}]}]\nlights: [{position: [0, 0, 5]}]\n")
     result = run("render", "bad.yaml", "-o", "f%d.png", *SMALL)
     assert (result.exit_code, result.output) == (
         2, "error: bad.yaml:3:65: objects[0].transform[0].scale: singular transform (determinant 0) "
