@@ -54,7 +54,7 @@ def test_objects_lists_every_object_with_its_material_bounds_and_shadow(validate
 def test_validate_without_objects_prints_the_summary_alone(validate):
     result = validate(CAM + LIGHT + "objects: [{sphere: {}}]\n")
     assert result.exit_code == 0 and result.stderr == ""
-    assert result.stdout == ("s.yaml: ok: 1 objects (1 sphere), 1 lights, 0 materials; 64x48, max_depth 5, "
+    assert result.stdout == ("s.yaml: ok: 1 object (1 sphere), 1 light, 0 materials; 64x48, max_depth 5, "
                              "phong, samples 1\n")
 
 

@@ -72,7 +72,7 @@ def test_usage_error_exit_2(run):
 def test_validate_summary(run):
     result = run("validate", "s.yaml")
     assert result.exit_code == 0
-    assert result.output.startswith("s.yaml: ok: 1 objects (1 sphere), 1 lights")
+    assert result.output.startswith("s.yaml: ok: 1 object (1 sphere), 1 light")
 
 
 def test_presets_lists_brass(run):

@@ -15,7 +15,7 @@ from rtcli.core import camera as cameras
 from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
-from rtcli.errors import SceneError
+from rtcli.errors import SceneError, plural
 from rtcli.scenefile import remarks, yamlfile
 from rtcli.scenefile.files import reading_scene
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
@@ -239,6 +239,6 @@ def summary(scene: Scene) -> str:
     for o in scene.objects:
         kinds[o.kind] = kinds.get(o.kind, 0) + 1
     shapes = ", ".join(f"{n} {k}" for k, n in kinds.items())
-    return (f"{len(scene.objects)} objects ({shapes or 'none'}), {len(scene.lights)} lights, "
-            f"{len(scene.materials) - 1} materials; {s.width}x{s.height}, max_depth {s.max_depth}, "
+    return (f"{plural(len(scene.objects), 'object')} ({shapes or 'none'}), {plural(len(scene.lights), 'light')}, "
+            f"{plural(len(scene.materials) - 1, 'material')}; {s.width}x{s.height}, max_depth {s.max_depth}, "
             f"{s.specular}, samples {s.samples}")
