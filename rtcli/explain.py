@@ -23,7 +23,7 @@ import numpy as np
 
 from rtcli.core.lights import COLOR, POSITION, attenuation, spot_factor
 from rtcli.core.scene import Scene
-from rtcli.errors import RtcliError
+from rtcli.errors import RtcliError, one_line
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays
@@ -116,6 +116,7 @@ class Glass:
     theta_t: float | None          # degrees; None past the critical angle
     R: float                       # Fresnel's reflectance (1 at total internal reflection)
     tir: bool                      # total internal reflection
+    fresnel: bool = True           # the weights are kr R and kt (1 - R); else kr and kt as given
 
 
 @dataclass
@@ -161,6 +162,19 @@ class RayNode:
         for child in self.children:
             yield from child.walk()
 
+    def __str__(self) -> str:
+        """The ray's tree as text, as `rtcli explain` prints it."""
+        from rtcli.explain_text import node_lines
+        return "\n".join(node_lines(self, lambda text, role: text))
+
+    def __repr__(self) -> str:
+        what = "misses" if self.hit is None else f"hits #{self.hit.object} {one_line(self.hit.name) or '(unnamed)'}"
+        return f"<rtcli RayNode: {self.kind} ray, depth {self.depth}, {what}; print() shows its tree>"
+
+    def _repr_pretty_(self, p, cycle: bool) -> None:
+        """IPython and Jupyter show the tree (IPython's pretty-printing protocol)."""
+        p.text(str(self))
+
 
 @dataclass
 class Explanation:
@@ -198,6 +212,16 @@ class Explanation:
 
     def __str__(self) -> str:
         return self.text(None if len(self.trees) == 1 else 0)
+
+    def __repr__(self) -> str:
+        from rtcli.explain_text import vec
+        return (f"<rtcli Explanation of pixel ({self.x}, {self.y}) of {self.width}x{self.height} = {vec(self.value)} "
+                f"-> 8-bit {tuple(int(b) for b in self.byte)}; print() shows its tree>")
+
+    def _repr_pretty_(self, p, cycle: bool) -> None:
+        """IPython and Jupyter show the tree, as `rtcli explain` prints it (IPython's
+        pretty-printing protocol), instead of the dataclass's fields."""
+        p.text(str(self))
 
 
 class Recorder(Log):
@@ -263,7 +287,7 @@ class Recorder(Log):
         theta_i = math.degrees(math.acos(min(1.0, max(-1.0, cos_i))))
         sin_t = n1 / n2 * math.sin(math.radians(theta_i))
         self.node.glass = Glass(n1, n2, cos_i, theta_i, None if tir else math.degrees(math.asin(min(1.0, sin_t))),
-                                float(R[0]), tir)
+                                float(R[0]), tir, self.node.hit.coefficients["fresnel"])
 
     def child(self, rows, kind: str, weights) -> Recorder:
         node = RayNode(kind, self.node.depth + 1, np.zeros(3), np.zeros(3), weights[:, 0].copy())

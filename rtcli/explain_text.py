@@ -128,10 +128,12 @@ def feeler_text(f) -> str:
 
 
 def glass_line(g) -> str:
+    """Snell's numbers, and what weighs the two rays: Fresnel's R, or the material's kr and kt."""
     text = (f"glass: n1 {num(g.n1)} -> n2 {num(g.n2)}, incidence {g.theta_i:.4g} deg, ")
     if g.tir:
         return text + "total internal reflection (no refracted ray)"
-    return text + f"refraction {g.theta_t:.4g} deg, Fresnel R {num(g.R)}"
+    weights = f"Fresnel R {num(g.R)}" if g.fresnel else "weights kr and kt as given (fresnel: false)"
+    return text + f"refraction {g.theta_t:.4g} deg, {weights}"
 
 
 def _term(label: str, value, style, role: str = "term") -> str:

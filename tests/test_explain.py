@@ -206,6 +206,16 @@ def test_glass_shows_snell_and_total_internal_reflection():
     assert "total internal reflection" in rtcli.explain(GLASS.replace("degrees: 30", "degrees: 60"), 10, 10).text()
 
 
+def test_glass_names_what_weighs_its_rays_fresnel_or_the_given_kr_and_kt():
+    plain = rtcli.explain(GLASS, 10, 10)
+    fresnel = rtcli.explain(GLASS.replace("shadow: false}", "shadow: false, fresnel: true}"), 10, 10)
+    assert (plain.trees[0].glass.fresnel, fresnel.trees[0].glass.fresnel) == (False, True)
+    assert "weights kr and kt as given (fresnel: false)" in plain.text() and "Fresnel R" not in plain.text()
+    R = fresnel.trees[0].glass.R
+    assert f"Fresnel R {R:.6g}" in fresnel.text() and "as given" not in fresnel.text()
+    assert fresnel.trees[0].children[0].weight == pytest.approx(0.05 * R)   # kr R, as the text says
+
+
 def test_misses_and_max_depth_say_so():
     e = rtcli.explain(SPHERE, 0, 0)
     assert e.trees[0].hit is None and e.value.tolist() == [0, 0, 0]
