@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.errors import RtcliError
+from rtcli.errors import RtcliError, plural
 from rtcli.results import ImageArray
 from rtcli.scene_api import Scene, Source
 from rtcli.wavefront.trace import Log
@@ -141,21 +141,25 @@ def summary(data: np.ndarray, kind: str, max_depth: int = 5) -> str:
     if kind == "depth":
         finite = np.isfinite(data)
         if not finite.any():
-            return f"depth: every ray misses ({pixels} pixels black)"
+            return f"depth: every ray misses ({plural(pixels, 'pixel')} black)"
         return (f"depth: {data[finite].min():.6g} (white) to {data[finite].max():.6g}, gray = nearest / depth; "
-                f"{pixels - int(finite.sum())} pixels miss (black)")
+                f"{_missed(pixels - int(finite.sum()))} (black)")
     if kind == "bounces":
         hit = data >= 0
         top = int(data.max()) if hit.any() else 0
         return (f"bounces: 0 (dark blue) to {max_depth - 1} (yellow, max_depth {max_depth}); deepest here {top}; "
-                f"{pixels - int(hit.sum())} pixels miss (black)")
+                f"{_missed(pixels - int(hit.sum()))} (black)")
     if kind == "uv":
         seen = np.isfinite(data).all(axis=2)
         if not seen.any():
-            return f"uv: every ray misses ({pixels} pixels blue)"
+            return f"uv: every ray misses ({plural(pixels, 'pixel')} blue)"
         u, v = data[seen].T
         return (f"uv: red = u, green = v (whole part dropped); u {u.min():.4g} to {u.max():.4g}, "
-                f"v {v.min():.4g} to {v.max():.4g}; {pixels - int(seen.sum())} pixels miss (blue)")
+                f"v {v.min():.4g} to {v.max():.4g}; {_missed(pixels - int(seen.sum()))} (blue)")
     return {"normal": "normal: color = (n + 1) / 2 of the outward shading normal; black: a miss",
             "albedo": "albedo: kd T of the first hit; black: a miss",
             "ids": "ids: the signature's colors, one per object"}[kind]
+
+
+def _missed(n: int) -> str:
+    return f"{plural(n, 'pixel')} {'misses' if n == 1 else 'miss'}"

@@ -98,6 +98,8 @@ def test_many_0_255_colors_are_listed_up_to_a_count(validate):
     found = warnings_of(validate(CAM + LIGHT + "objects:\n" + spheres))
     assert len(found) == 21 and found[-1].startswith("s.yaml:25:")
     assert found[-1].endswith("warning: 5 more colors that look like 0-255 values (the first 20 are above)")
+    found = warnings_of(validate(CAM + LIGHT + "objects:\n" + spheres.split("\n", 4)[-1]))     # 21 of them
+    assert found[-1].endswith("warning: 1 more color that looks like 0-255 values (the first 20 are above)")
 
 
 # --- lights, camera, objects ---

@@ -219,3 +219,22 @@ def _alone(scene, k: int):
     single.__dict__.pop("boxes", None)
     single.objects = [scene.objects[k]]
     return single
+
+
+# --- counts ---
+def test_counts_say_1_thing_and_2_things():
+    from rtcli.errors import plural
+    from rtcli.views import summary
+    assert [plural(n, "warning") for n in (0, 1, 2)] == ["0 warnings", "1 warning", "2 warnings"]
+    assert plural(1, "mesh", "meshes") + ", " + plural(3, "mesh", "meshes") == "1 mesh, 3 meshes"
+    assert summary(np.array([[np.inf, 2.0]]), "depth").endswith("; 1 pixel misses (black)")
+    assert summary(np.array([[np.inf, np.inf, 2.0]]), "depth").endswith("; 2 pixels miss (black)")
+    assert summary(np.array([[np.inf]]), "depth") == "depth: every ray misses (1 pixel black)"
+
+
+def test_validate_s_summary_counts_in_singular_or_plural(run, tmp_path):
+    (tmp_path / "one.yaml").write_text("animation: {frames: 1}\n" + CLEAN.replace(
+        "eye: [0, 0, 5]", "eye: {keys: {0: [0, 0, 5]}}"))
+    assert run("validate", "one.yaml").stdout == (
+        "one.yaml: ok: 1 object (1 sphere), 1 light, 1 material; 32x24, max_depth 5, phong, samples 1; "
+        "animated: 1 frame at 24 fps (0..0.0416667 s), 1 keyframed value\n")

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.core.scene import Scene
-from rtcli.errors import SceneError, Where, shown
+from rtcli.errors import SceneError, Where, plural, shown
 from rtcli.scenefile import yamlfile
 from rtcli.scenefile.build import build_scene
 from rtcli.scenefile.files import reading_scene
@@ -100,7 +100,7 @@ class Track:
             raise SceneError(where, keys.key_path(name), "a keyframe's time must be a number of seconds") from None
         if not math.isfinite(t) or not clock.start <= t <= clock.end:
             raise SceneError(where, keys.key_path(name), f"time {t:g} is outside the clock range "
-                             f"{clock.start:g}..{clock.end:g} s ({clock.frames} frames at {clock.fps:g} fps)")
+                             f"{clock.start:g}..{clock.end:g} s ({plural(clock.frames, 'frame')} at {clock.fps:g} fps)")
         if self.times and t <= self.times[-1]:
             raise SceneError(where, keys.key_path(name), f"keyframes must be in increasing time: {t:g} "
                              f"follows {self.times[-1]:g}")
@@ -290,8 +290,8 @@ class Animation:
         for t in sorted({t for track in self.tracks.values() for t in track.times}):
             self.scene_at(t)
         c = self.clock
-        return (f"; animated: {c.frames} frames at {c.fps:g} fps ({c.start:g}..{c.end:g} s), "
-                f"{len(self.tracks)} keyframed values")
+        return (f"; animated: {plural(c.frames, 'frame')} at {c.fps:g} fps ({c.start:g}..{c.end:g} s), "
+                f"{plural(len(self.tracks), 'keyframed value')}")
 
 
 def _trie(tracks: dict) -> dict:
