@@ -374,7 +374,8 @@ def test_missing_texture_image(tmp_path):
     text = CAM + "materials:\n  m:\n    texture: {image: nope.png}\n"
     #                                              'nope.png' at 22 of line 4
     assert error_of(text, tmp_path) == (f"{tmp_path}/scene.yaml:4:22: materials.m.texture.image: "
-                                        f"file not found: {tmp_path}/nope.png")
+                                        f"file not found: {tmp_path}/nope.png (looked for in {tmp_path}: a relative "
+                                        "name starts from the folder of the file it is written in)")
 
 
 # --- what loads: cameras ---

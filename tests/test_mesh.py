@@ -171,7 +171,8 @@ def test_yaml_reads_a_file_relative_to_the_scene(tmp_path):
 
 
 @pytest.mark.parametrize("obj, message", [
-    (None, "mesh.file: file not found: {tmp}/m.obj"),
+    (None, "mesh.file: file not found: {tmp}/m.obj (looked for in {tmp}: a relative name starts from the folder "
+           "of the file it is written in)"),
     ("# empty\n", "mesh.file: the mesh has no faces: {tmp}/m.obj"),
     (TRIANGLE + "f 1 1 2\n", "mesh.file: all triangles of the mesh have zero area: {tmp}/m.obj"),
 ])
@@ -223,3 +224,25 @@ def test_models_with_vt_and_vn():
     assert len(suzanne.normals) and np.all(suzanne.normal_faces >= 0)
     mesh = Mesh(suzanne.vertices, suzanne.faces, True, normals=suzanne.normals, normal_faces=suzanne.normal_faces)
     assert mesh.smooth and np.all(np.any(mesh.pool[:, NA:NA + 9] != 0, axis=1))    # every face's corner normals
+
+
+def test_a_missing_mesh_names_the_folder_it_was_looked_for_in(tmp_path, monkeypatch):
+    """A mesh named in an include is looked for beside the include, not beside the scene: the
+    error says where it looked and why."""
+    import rtcli
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "models").mkdir()
+    (tmp_path / "models" / "m.obj").write_text(TRIANGLE + "f 1 2 3\n")           # beside the scene: not used
+    (tmp_path / "common").mkdir()
+    (tmp_path / "common" / "mesh.yaml").write_text("objects:\n  - {mesh: {file: models/m.obj}}\n")
+    (tmp_path / "s.yaml").write_text("include: [common/mesh.yaml]\n")
+    with pytest.raises(SceneError) as e:
+        rtcli.load_scene("s.yaml")
+    assert str(e.value) == (f"common/mesh.yaml:2:19: objects[0].mesh.file: file not found: common/models/m.obj "
+                            f"(looked for in {tmp_path}/common/models: a relative name starts from the folder of the "
+                            "file it is written in)")
+    with pytest.raises(SceneError) as e:
+        rtcli.load_scene({"objects": [{"mesh": {"file": "m.obj"}}]}, folder="common")
+    assert str(e.value) == (f"<dict>: objects[0].mesh.file: file not found: common/m.obj (looked for in "
+                            f"{tmp_path}/common: a relative name starts from load_scene's folder, the current one "
+                            "by default)")

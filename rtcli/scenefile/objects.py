@@ -18,7 +18,7 @@ from rtcli.core import transform as tf
 from rtcli.core.materials import Material
 from rtcli.core.scene import SceneObject
 from rtcli.core.textures import Checker, ImageTexture
-from rtcli.errors import SceneError, quoted, shown
+from rtcli.errors import SOURCES, SceneError, quoted, shown
 from rtcli.scenefile import params as required
 from rtcli.scenefile import reuse
 from rtcli.scenefile.files import open_image
@@ -112,7 +112,7 @@ def load_texels(p: Params, key: str) -> np.ndarray:
                 texels[y:y + band] = np.asarray(rgb.crop((0, y, w, min(h, y + band))))
             return texels
     except FileNotFoundError:
-        raise p.error(key, f"file not found: {shown(path)}") from None
+        raise not_found(p, key, path) from None
     except (UnidentifiedImageError, OSError) as e:
         raise p.error(key, f"cannot read image {shown(path)}: {e}") from None
 
@@ -231,9 +231,21 @@ def _read_mesh_file(p: Params, key: str, path: str):
     try:
         return reuse.file_data(path, MAX_MESH_BYTES, lambda: read_obj(path))
     except FileNotFoundError:
-        raise p.error(key, f"file not found: {shown(path)}") from None
+        raise not_found(p, key, path) from None
     except OSError as e:
         raise p.error(key, f"cannot read {shown(path)}: {e.strerror or e}") from None
+
+
+def not_found(p: Params, key: str, path: str) -> SceneError:
+    """A mesh or texture file that is not there, with the folder it was looked for in and why
+    there: a relative name is relative to the folder of the file that names it (an include's,
+    not the scene's; for YAML text or a dict, load_scene's folder), and to no other."""
+    if os.path.isabs(p.string(key)):
+        return p.error(key, f"file not found: {shown(path)}")
+    base = "load_scene's folder, the current one by default" if p.node.file in SOURCES else \
+        "the folder of the file it is written in"
+    looked = shown(os.path.abspath(os.path.dirname(path)))
+    return p.error(key, f"file not found: {shown(path)} (looked for in {looked}: a relative name starts from {base})")
 
 
 def csg_from(p: Params, builder: "ObjectBuilder", material: int) -> CSG:
