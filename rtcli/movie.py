@@ -1,7 +1,9 @@
 """Animated images: the frames of an animation as one animated PNG or GIF (Pillow).
 
 An animated PNG keeps every pixel; a GIF has at most 256 colors a frame (Pillow
-picks them) and frame delays in hundredths of a second. Both loop forever. The
+picks them) and frame delays in hundredths of a second (an APNG's are written in
+milliseconds). Delays are whole ticks that alternate so the movie keeps its frame
+rate (`delays`). Both loop forever. The
 movie is written to a temporary file beside its name and renamed into place, so an
 interrupted run leaves no half-written movie; its frames are held in memory until
 then (3 bytes a pixel a frame, checked by `check_size`).
@@ -9,6 +11,7 @@ then (3 bytes a pixel a frame, checked by `check_size`).
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -18,6 +21,7 @@ from rtcli.errors import RtcliError, quoted, shown
 from rtcli.writer import write_atomic
 
 FORMATS = {".apng": "PNG", ".gif": "GIF"}
+TICK = {"PNG": 1, "GIF": 10}              # ms: the step of a frame's delay as written (Pillow's APNG: 1/1000 s)
 MAX_BYTES = 4 << 30                       # frames held in memory for one movie
 
 
@@ -49,4 +53,12 @@ def write_movie(path: str, frames: list[np.ndarray], fps: float) -> None:
     fmt = movie_format(path)
     images = [Image.fromarray(f) for f in frames]
     write_atomic(path, lambda f: images[0].save(f, format=fmt, save_all=True, append_images=images[1:],
-                                                duration=1000 / fps, loop=0))
+                                                duration=delays(len(images), fps, TICK[fmt]), loop=0))
+
+
+def delays(frames: int, fps: float, tick: int) -> list[int]:
+    """Each frame's delay in ms, a whole number of ticks: frame k ends at the tick nearest k / fps
+    seconds, so the delays alternate between the two nearest whole ticks (a GIF at 12 fps: 80, 90,
+    80, 80, 90, 80 ... ms for 83.3) and the movie lasts frames / fps to within half a tick."""
+    ends = [math.floor(k * 1000 / fps / tick + 0.5) * tick for k in range(frames + 1)]
+    return [b - a for a, b in zip(ends, ends[1:])]
