@@ -219,7 +219,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
                                       animation.overrides(samples, max_depth), workers, bar, shown_stats, lint)
         items, folder = batch.plan(list(scene_files), output, f".{view}.png" if view else ".png")
         if skip_existing:
-            items = [item for item in items if not os.path.isfile(item.output)]
+            items = runs.missing(items, width, height)
         note = lambda text: click.echo(f"note: {text}", err=True)                  # noqa: E731
         current = {}
 

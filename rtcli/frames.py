@@ -185,16 +185,31 @@ def _range(text: str | None, animation: Animation, scene_file: str) -> list[int]
     return list(range(first, last + 1))
 
 
-def to_render(seq: Sequence, skip_existing: bool) -> list[int]:
-    """The sequence's frames to render: all, or with `skip_existing` those whose files are missing."""
-    return [k for k in seq.frames if not (skip_existing and k in seq.paths and os.path.isfile(seq.paths[k]))]
+def to_render(seq: Sequence, skip_existing: bool, job) -> list[int]:
+    """The sequence's frames to render: all, or with `skip_existing` those without a file that is
+    an image of the job's size (one of another size is rendered again)."""
+    return [k for k in seq.frames
+            if not (skip_existing and k in seq.paths and has_image(seq.paths[k], job.width, job.height))]
+
+
+def has_image(path: str, width: int, height: int) -> bool:
+    """Whether `path` is a regular file holding an image of width x height (only its header is read):
+    what --skip-existing keeps."""
+    from PIL import Image, UnidentifiedImageError
+    if not os.path.isfile(path):
+        return False
+    try:
+        with Image.open(path) as img:
+            return img.size == (width, height)
+    except (OSError, UnidentifiedImageError, ValueError):
+        return False
 
 
 def render_sequence(loaded: Loaded, seq: Sequence, job, workers: int, changes: dict, skip_existing: bool,
                     progress=None, where=None) -> Stats:
     """Render the sequence's frames, writing each file as its frame is done and the movies at the
     end; frames whose files exist are skipped with `skip_existing` (read back for a movie)."""
-    todo = to_render(seq, skip_existing)
+    todo = to_render(seq, skip_existing, job)
     if seq.movies:
         check_size(len(seq.frames), job.width, job.height)
     for k in todo:

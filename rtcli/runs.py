@@ -110,7 +110,7 @@ def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: 
     size = job.pop("width"), job.pop("height"), job.pop("block_size")
     job = make_job(scene, *size, **job)
     show = progress_bar(bar, one_line(os.path.basename(scene_file)))
-    todo, rendering = animation.to_render(seq, skip_existing), time.perf_counter()
+    todo, rendering = animation.to_render(seq, skip_existing, job), time.perf_counter()
     counts = animation.render_sequence(loaded, seq, job, workers or os.cpu_count() or 1, changes, skip_existing,
                                        show, where)
     if not stats:
@@ -143,6 +143,25 @@ def watch_scene(item, load, render_one, stats: bool, as_json: bool) -> None:
             click.echo(line)
     click.echo(f"watching {shown(item.scene)} and the files it reads; Ctrl-C ends", err=as_json)
     watch(item.scene, once, stamped)
+
+
+def missing(items: list, width, height) -> list:
+    """--skip-existing with several scenes: the items (batch.Item) without an image of the size the
+    scene renders at (an image of another size is rendered again). A scene whose image exists is
+    loaded to learn its size; one that fails to load stays in, to fail where it renders."""
+    from rtcli.errors import RtcliError
+    from rtcli.frames import has_image, load
+    todo = []
+    for item in items:
+        if os.path.isfile(item.output):
+            try:
+                w, h, _ = check_size(load(item.scene).scene, width, height)
+            except RtcliError:
+                w = h = 0
+            if w and has_image(item.output, w, h):
+                continue
+        todo.append(item)
+    return todo
 
 
 def view(scene, kind: str, width, height, tile: int, label: str | None):

@@ -189,13 +189,37 @@ def test_frame_n_of_several_scenes_is_each_scene_s_frame_n(run, tmp_path):
 
 def test_skip_existing_with_several_scenes_renders_only_the_missing_images(run, tmp_path):
     shutil.copy(ORBIT, tmp_path / "other.yaml")
+    shutil.copy(ORBIT, tmp_path / "third.yaml")
     (tmp_path / "out").mkdir()
-    (tmp_path / "out" / "orbit.png").write_bytes(b"kept")
-    result = run("render", "orbit.yaml", "other.yaml", "-o", "out", "--skip-existing", "--stats", *SMALL)
+    Image.new("RGB", (40, 30), "red").save(tmp_path / "out" / "orbit.png")        # the size asked for: kept
+    kept = (tmp_path / "out" / "orbit.png").read_bytes()
+    Image.new("RGB", (20, 15), "red").save(tmp_path / "out" / "third.png")        # another size: rendered again
+    result = run("render", "orbit.yaml", "other.yaml", "third.yaml", "-o", "out", "--skip-existing", "--stats",
+                 *SMALL)
     assert result.exit_code == 0, result.output
-    assert result.output.startswith("other.yaml: rays: ") and result.output.count("\n") == 1
-    assert (tmp_path / "out" / "orbit.png").read_bytes() == b"kept"
+    assert [line.split(":")[0] for line in result.output.splitlines()] == ["other.yaml", "third.yaml"]
+    assert (tmp_path / "out" / "orbit.png").read_bytes() == kept
     assert Image.open(tmp_path / "out" / "other.png").size == (40, 30)
+    assert (tmp_path / "out" / "third.png").read_bytes() == (tmp_path / "out" / "other.png").read_bytes()
+    (tmp_path / "out" / "other.png").write_bytes(b"not an image")                  # rendered again too
+    result = run("render", "orbit.yaml", "other.yaml", "third.yaml", "-o", "out", "--skip-existing", "--stats",
+                 "--height", "15")
+    assert [line.split(":")[0] for line in result.output.splitlines()] == ["orbit.yaml", "other.yaml", "third.yaml"]
+    assert Image.open(tmp_path / "out" / "orbit.png").size == (20, 15)
+
+
+def test_skip_existing_renders_again_a_frame_of_another_size(run, tmp_path):
+    """A run resumed at another size must not mix sizes: frames of the old size are rendered again."""
+    assert run("render", "orbit.yaml", "--frames", "1-3", "-o", "f%d.png", "--width", "20").exit_code == 0
+    assert run("render", "orbit.yaml", "--frames", "2-2", "-o", "f%d.png", *SMALL).exit_code == 0
+    before = os.stat(tmp_path / "f2.png").st_mtime_ns
+    result = run("render", "orbit.yaml", "--frames", "1-3", "-o", "f%d.png", "--skip-existing", "--movie", "m.gif",
+                 "--stats", "--json", *SMALL)
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.output)["frames"] == [1, 3]
+    assert os.stat(tmp_path / "f2.png").st_mtime_ns == before
+    assert [Image.open(tmp_path / f"f{k}.png").size for k in (1, 2, 3)] == [(40, 30)] * 3
+    assert durations(tmp_path / "m.gif") and Image.open(tmp_path / "m.gif").size == (40, 30)
 
 
 def test_a_view_and_an_explanation_take_the_frame(run, tmp_path):
