@@ -28,7 +28,8 @@ COLOR = ("s.yaml:4:44: objects[0].material.diffuse: warning: [255, 128, 0] looks
          "run from 0 to 1 here: [1, 0.502, 0] or \"#ff8000\" (write 255.0 if more than 1 is meant)")
 CLEAN = SCENE.replace("[255, 128, 0]", "[1, 0.5, 0]")
 DARK = "image: {width: 32, height: 24}\ncamera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nobjects: [{sphere: {}}]\n"
-NO_LIGHTS = "d.yaml:1:1: lights: warning: no lights: only ambient light and emission show (a light is {position: [x, y, z]})"
+NO_LIGHTS = ("d.yaml:1:1: lights: warning: no lights: only ambient light and emission show (a light is "
+             "{position: [x, y, z]})")
 
 
 @pytest.fixture
@@ -97,7 +98,7 @@ def test_an_animation_warns_about_frame_1_before_its_first_frame(run, tmp_path):
     result = run("render", "d.yaml", "-o", "f%d.png")
     assert result.exit_code == 0, result.output
     assert result.stderr.splitlines() == [
-        NO_LIGHTS.replace("d.yaml:1:1", "d.yaml:1:1"),
+        NO_LIGHTS,
         "note: the warnings are about frame 1 of 3 (the camera, lights and objects where the animation starts)"]
     result = run("render", "d.yaml", "-o", "g%d.png", "--strict")
     assert result.exit_code == 2 and not any(name.startswith("g") for name in os.listdir(tmp_path))
