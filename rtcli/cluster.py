@@ -41,7 +41,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rtcli import __version__
-from rtcli.errors import RtcliError, shown
+from rtcli.errors import RtcliError, plural, shown
 
 RAYS_PER_TASK = 2_000_000         # primary rays a task traces, at most (unless that leaves workers idle)
 TASKS_PER_WORKER = 4              # at least this many tasks a worker thread, so all finish together
@@ -61,7 +61,7 @@ class Target:
 
     def __str__(self) -> str:
         if self.local:
-            return f"a local cluster of {self.local} workers"
+            return f"a local cluster of {plural(self.local, 'worker')}"
         return f"the Dask scheduler at {shown(self.address)}"
 
 

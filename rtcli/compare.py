@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from rtcli.errors import RtcliError, shown
+from rtcli.errors import RtcliError, plural, shown
 
 _EIGHT = np.ones((3, 3), dtype=int)     # 8-connectivity for ndimage.label
 
@@ -130,7 +130,7 @@ def compare_images(actual, expected, tolerance: int = 2, max_bad_pixels: int = 1
     max_at = _xy(np.argmax(pixel_err), w) if max_err > 0 else None
     mean = total / (h * w * 3) if h * w else 0.0
     ok = n_bad <= limit and cluster <= max_cluster
-    summary = (f"{'OK' if ok else 'FAIL'}: {n_bad} bad pixels (limit {limit}), "
+    summary = (f"{'OK' if ok else 'FAIL'}: {plural(n_bad, 'bad pixel')} (limit {limit}), "
                f"largest cluster {cluster} px{_at(cluster_at)}, "
                f"max error {max_err}/255{_at(max_at)}, mean error {mean:.2f}/255")
     return Comparison(ok, summary, n_bad, limit, cluster, cluster_at, max_err, max_at, mean)
@@ -156,8 +156,8 @@ def compare_ids(actual, expected, max_boundary_mismatch: int = 8,
     n_off, n_on, n_boundary = int(off.sum()), int(on.sum()), int(boundary.sum())
     limit = _limit(max_boundary_mismatch, max_boundary_fraction, n_boundary)
     ok = n_off == 0 and n_on <= limit
-    summary = (f"{'OK' if ok else 'FAIL'}: {n_off + n_on} mismatched ids ({n_off} off boundary, "
-               f"{n_on} on boundary, limit {limit} of {n_boundary} boundary pixels)")
+    summary = (f"{'OK' if ok else 'FAIL'}: {plural(n_off + n_on, 'mismatched id')} ({n_off} off boundary, "
+               f"{n_on} on boundary, limit {limit} of {plural(n_boundary, 'boundary pixel')})")
     first = off if n_off else on
     if n_off or n_on:
         i = int(np.argmax(first.ravel()))

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli import compare as gate
-from rtcli.errors import RtcliError, one_line, shown
+from rtcli.errors import RtcliError, one_line, plural, shown
 
 RANK = {"unreadable": 0, "missing": 1, "extra": 2, "failing": 3, "ok": 4}      # worst first
 
@@ -104,7 +104,7 @@ def total_line(pairs: list[Pair]) -> str:
     """The last line `rtcli compare` prints for two folders."""
     c = counts(pairs)
     verdict = "OK" if c["ok"] == len(pairs) else "FAIL"
-    return (f"{verdict}: {len(pairs)} pairs: {c['ok']} ok, {c['failing']} failing, {c['missing']} missing, "
+    return (f"{verdict}: {plural(len(pairs), 'pair')}: {c['ok']} ok, {c['failing']} failing, {c['missing']} missing, "
             f"{c['extra']} extra, {c['unreadable']} unreadable")
 
 

@@ -257,7 +257,7 @@ def test_single_off_boundary_mismatch_fails():
     actual[70, 60] = 3                     # the centre of disc 2
     c = compare_ids(actual, expected)
     assert not c.ok and c.bad_pixels == 1 and c.off_boundary == 1
-    assert c.summary.startswith("FAIL: 1 mismatched ids (1 off boundary, 0 on boundary, limit 12 of ")
+    assert c.summary.startswith("FAIL: 1 mismatched id (1 off boundary, 0 on boundary, limit 12 of ")
     assert c.summary.endswith("first off-boundary at (x=60, y=70): actual 3, expected 2")
 
 

@@ -231,6 +231,12 @@ def test_counts_say_1_thing_and_2_things():
     assert summary(np.array([[np.inf, 2.0]]), "depth").endswith("; 1 pixel misses (black)")
     assert summary(np.array([[np.inf, np.inf, 2.0]]), "depth").endswith("; 2 pixels miss (black)")
     assert summary(np.array([[np.inf]]), "depth") == "depth: every ray misses (1 pixel black)"
+    a = np.zeros((4, 4, 3), np.uint8)
+    b = a.copy()
+    b[1, 2] = 9
+    assert rtcli.diff(a, b).summary.startswith("OK: 1 bad pixel (limit 16), ")
+    b[2, 2] = 9
+    assert rtcli.diff(a, b).summary.startswith("OK: 2 bad pixels (limit 16), ")
 
 
 def test_validate_s_summary_counts_in_singular_or_plural(run, tmp_path):
