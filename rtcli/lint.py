@@ -58,14 +58,19 @@ def lines(found: list[Remark], scene_file: str, frames: int, several: bool = Fal
 
 def warn(found: list[Remark]) -> None:
     """Each warning as a Python RtcliWarning, attributed to the first caller outside rtcli (the
-    notebook cell or script line that loaded the scene)."""
+    notebook cell or script line that loaded the scene). Every load warns again, as every render
+    does: Python's default filter would show a warning once per line, and a cell run again after
+    an edit elsewhere would then hide it."""
+    frame = _outside_rtcli(sys._getframe(1))
     for remark in found:
-        warnings.warn(RtcliWarning(one_line(f"{remark.where}: {remark.message}")), stacklevel=_outside_rtcli())
+        warnings.warn_explicit(RtcliWarning(one_line(f"{remark.where}: {remark.message}")), RtcliWarning,
+                               frame.f_code.co_filename, frame.f_lineno, frame.f_globals.get("__name__", ""),
+                               registry=None, module_globals=frame.f_globals)
 
 
-def _outside_rtcli() -> int:
-    """The stacklevel, for warnings.warn called by warn(), of the first frame not in rtcli."""
-    frame, level = sys._getframe(2), 2                   # 1: warn(), which calls warnings.warn
+def _outside_rtcli(frame):
+    """The first frame from `frame` outward whose code is not rtcli's (`frame` itself if all are)."""
+    first = frame
     while frame is not None and frame.f_globals.get("__name__", "").partition(".")[0] == "rtcli":
-        frame, level = frame.f_back, level + 1
-    return level
+        frame = frame.f_back
+    return frame or first

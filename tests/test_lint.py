@@ -155,6 +155,16 @@ def test_yaml_text_and_dicts_warn_too():
         assert rtcli.load_scene(CLEAN).warnings == ()
 
 
+def test_every_load_warns_again_under_python_s_default_filter():
+    """The default filter shows a warning once per line; a scene loaded again (a cell run again)
+    must say it again, as every render does."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        for _ in range(2):
+            rtcli.load_scene(DARK)
+    assert [str(w.message)[:31] for w in caught] == ["<string>:1:1: lights: no lights"] * 2
+
+
 def test_warnings_as_errors_stop_the_load():
     with warnings.catch_warnings():
         warnings.simplefilter("error", rtcli.RtcliWarning)
