@@ -5,7 +5,7 @@ Loading asked for them records where things are written (scenefile/remarks.py), 
 checks.warnings looks at frame 1, as `validate` does. The command line prints each on
 stderr, one line in validate's located form, before anything is traced; `--quiet` hides
 them, `--strict` makes the first an error. The Python API raises them as Python warnings
-(RtcliError's sibling RtcliWarning) when it loads a scene, so notebooks show them.
+(rtcli.RtcliWarning, a UserWarning) when it loads a scene, so notebooks show them.
 """
 
 from __future__ import annotations
