@@ -390,15 +390,13 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
 def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
     """Whether compare is given two folders; a usage error for a folder and a file, or for options
     of the other mode."""
-    folders = os.path.isdir(actual), os.path.isdir(expected)
-    if folders[0] != folders[1]:
-        raise click.UsageError(f"{shown(actual if folders[0] else expected)} is a folder: compare two folders "
-                               "or two images")
-    if folders[0] and pair_options:
+    from rtcli.compare_dirs import are_folders
+    folders = are_folders(actual, expected)
+    if folders and pair_options:
         raise click.UsageError("--diff, --flip and --ids compare two images; two folders get --report")
-    if not folders[0] and folder_options:
+    if not folders and folder_options:
         raise click.UsageError("--report and --junit compare two folders")
-    return folders[0]
+    return folders
 
 
 @main.command()
