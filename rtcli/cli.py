@@ -17,7 +17,7 @@ import threading
 import click
 
 from rtcli import __version__
-from rtcli.errors import Interrupted, RtcliError, one_line, shown
+from rtcli.errors import Interrupted, RtcliError, error_line, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
 VIEWS = ("normal", "depth", "uv", "albedo", "bounces", "ids")          # rtcli/views.py, not imported to start
@@ -55,7 +55,7 @@ class RtcliGroup(click.Group):
         except (RtcliError, MemoryError) as e:
             if "--debug" in args:
                 raise
-            click.echo(f"error: {one_line(str(e) or 'out of memory')}", err=True)
+            click.echo(error_line(e), err=True)
             sys.exit(2)
         finally:
             restore()
@@ -169,12 +169,14 @@ def _cluster(address, file, local):
 @click.option("--movie", metavar="MOVIE.apng", callback=_not_empty,
               help="Also write the frames as an animated PNG (.apng) or GIF (.gif).")
 @click.option("--skip-existing", is_flag=True, help="Leave the frames (or images) already written; render the rest.")
+@click.option("--keep-going", is_flag=True, help="Several scenes or a folder: when one is broken, print its error, "
+                                                 "render the others, and exit 2 at the end.")
 @_cluster_options
 @click.option("--watch", is_flag=True, help="Render again whenever the scene or a file it reads changes; "
                                             "print each render's time; Ctrl-C ends.")
 def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
            gamma, quiet, progress, stats, as_json, engine, no_bvh, view, frame_range, frame, movie, skip_existing,
-           cluster, cluster_file, local_cluster, watch):
+           keep_going, cluster, cluster_file, local_cluster, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
     from rtcli import api, batch, runs
@@ -202,6 +204,9 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
                                "frame pattern, a movie or --skip-existing")
     if watch and (cluster or cluster_file or local_cluster):
         raise click.UsageError("--watch renders on this machine: it takes no cluster option")
+    if keep_going and (watch or sequence):
+        raise click.UsageError("--keep-going renders the other scenes when one is broken: it takes no --watch, "
+                               "--frames, frame pattern or movie")
     where = _cluster(cluster, cluster_file, local_cluster)
     bar = not quiet and (progress or sys.stderr.isatty())
     with where or contextlib.nullcontext():
@@ -238,9 +243,17 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
                               progress=show, notes=note)
         if watch:
             return runs.watch_scene(items[0], load, render_one, stats, as_json)
-        done = batch.run(items, folder, load, render_one) if items else []
+        broken = []
+
+        def skip(item, error):
+            broken.append(item)
+            click.echo(batch.broken_line(item, error), err=True)
+        done = batch.run(items, folder, load, render_one, ids=view == "ids",
+                         keep_going=skip if keep_going else None) if items else []
     for line in batch.stats_lines(done, as_json, folder is not None) if stats else ():
         click.echo(line)
+    if broken:
+        raise click.exceptions.Exit(2)
 
 
 @main.command()
@@ -390,15 +403,13 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
 def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
     """Whether compare is given two folders; a usage error for a folder and a file, or for options
     of the other mode."""
-    folders = os.path.isdir(actual), os.path.isdir(expected)
-    if folders[0] != folders[1]:
-        raise click.UsageError(f"{shown(actual if folders[0] else expected)} is a folder: compare two folders "
-                               "or two images")
-    if folders[0] and pair_options:
+    from rtcli.compare_dirs import are_folders
+    folders = are_folders(actual, expected)
+    if folders and pair_options:
         raise click.UsageError("--diff, --flip and --ids compare two images; two folders get --report")
-    if not folders[0] and folder_options:
+    if not folders and folder_options:
         raise click.UsageError("--report and --junit compare two folders")
-    return folders[0]
+    return folders
 
 
 @main.command()

@@ -123,9 +123,10 @@ def watch_scene(item, load, render_one, stats: bool, as_json: bool) -> None:
 
 
 def view(scene, kind: str, width, height, tile: int, label: str | None):
-    """A debug view's picture (rtcli/views.py), its summary line printed."""
+    """A debug view's picture (rtcli/views.py), its summary line printed; the ids view as its id
+    map, which `rtcli compare --ids` reads (README.md, Commands)."""
     from rtcli.results import ImageArray
     from rtcli.views import summary, view
     data = view(scene, kind, width=width, height=height, tile=tile)
     click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
-    return ImageArray(data.to_8bit(), inputs=scene.inputs)
+    return data if data.is_ids else ImageArray(data.to_8bit(), inputs=scene.inputs)
