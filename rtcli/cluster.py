@@ -317,7 +317,7 @@ class Session:
         """Refuse workers whose software differs; wait a while for a first worker."""
         distributed = _distributed()
         try:
-            self.client.wait_for_workers(1, timeout=_timeout())
+            self.client.wait_for_workers(1, timeout=connect_timeout())
         except (TimeoutError, distributed.TimeoutError):
             raise RtcliError(f"{self.where} has no workers (start some: README.md, Clusters)") from None
         try:
@@ -413,7 +413,7 @@ def _sigint_ignored():
         signal.signal(signal.SIGINT, previous)
 
 
-def _timeout() -> float:
+def connect_timeout() -> float:
     """Dask's connect timeout (distributed.comm.timeouts.connect), in seconds."""
     import dask
     from dask.utils import parse_timedelta

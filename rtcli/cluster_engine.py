@@ -18,6 +18,8 @@ distributed is imported only by the code that runs on a cluster.
 
 from __future__ import annotations
 
+import threading
+
 from rtcli.errors import RtcliError
 
 TOPIC = "rtcli-engine"               # the Dask event topic of the workers' engine notes
@@ -25,10 +27,11 @@ TOPIC = "rtcli-engine"               # the Dask event topic of the workers' engi
 
 # --- on a worker ---
 class Told:
-    """A worker's notes about its engine (loading.ready's `notes`), sent to the clients as they happen."""
+    """A worker's notes about its engine (loading.ready's `notes`), sent to the clients as they happen;
+    `sent` counts them."""
 
     def __init__(self, worker):
-        self.worker = worker
+        self.worker, self.sent = worker, 0
 
     def __call__(self, text: str) -> None:
         self._send(note=text)
@@ -40,6 +43,7 @@ class Told:
 
     def _send(self, **msg) -> None:
         self.worker.log_event(TOPIC, {"worker": self.worker.address, **msg})      # safe from any thread
+        self.sent += 1
 
 
 def told() -> Told | None:
@@ -57,7 +61,8 @@ class Heard:
     each note passed on at once to `notes`, and the seconds each worker compiled, for summary()."""
 
     def __init__(self, notes):
-        self.notes, self.compiling = notes, {}
+        self.notes, self.compiling, self.counts = notes, {}, {}
+        self._changed = threading.Condition()
 
     def __call__(self, event) -> None:
         try:
@@ -68,7 +73,16 @@ class Heard:
             if "compiled" in msg:
                 self.compiling[worker] = self.compiling.get(worker, 0.0) + float(msg["compiled"])
         except Exception:          # runs in Dask's event loop: a malformed event must not stop the client
-            pass
+            return
+        with self._changed:
+            self.counts[worker] = self.counts.get(worker, 0) + 1
+            self._changed.notify_all()
+
+    def wait(self, sent: dict, timeout: float) -> None:
+        """Until the notes `sent` ({worker: how many}) have all been heard, or `timeout` seconds: they
+        come through the scheduler by another way than a Client.run's answer, and may come later."""
+        with self._changed:
+            self._changed.wait_for(lambda: all(self.counts.get(w, 0) >= n for w, n in sent.items()), timeout)
 
     def summary(self) -> None:
         """A note for each worker that compiled since the last summary, with how long it took."""
@@ -86,8 +100,14 @@ async def warm_here(client: dict, dask_worker=None) -> dict:
 
 
 def _warm(client: dict, notes: Told) -> dict:
-    """rtcli.compiled.warmup here, its notes told to the client: {"parts": [(what, compile seconds)],
-    "seconds": in all, "why": why a machine code file is missing}, or {"failed": why}."""
+    """_warmed, and "told": how many notes it sent (warm waits until the client heard them)."""
+    return {**_warmed(client, notes), "told": notes.sent}
+
+
+def _warmed(client: dict, notes: Told) -> dict:
+    """rtcli.compiled.warmup here, for a client whose software is this worker's, its notes told to
+    the client: {"parts": [(what, compile seconds)], "seconds": in all, "why": why a machine code
+    file is missing}, or {"failed": why}."""
     import time
 
     from rtcli.cluster import fingerprint, mismatch
@@ -107,8 +127,10 @@ def _warm(client: dict, notes: Told) -> dict:
 def warm(session, echo) -> None:
     """Warm every worker of a cluster.Session at once, and `echo` a line for each, by address;
     RtcliError, in one line, naming the workers that could not be warmed (after the others' lines)."""
-    from rtcli.cluster import fingerprint
+    from rtcli.cluster import connect_timeout, fingerprint
     found = session.run(warm_here, fingerprint())
+    session.heard.wait({w: r["told"] for w, r in found.items() if isinstance(r, dict) and "told" in r},
+                       connect_timeout())
     failed = []
     for address, result in sorted(found.items()):
         if isinstance(result, dict) and "parts" in result:
