@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import re
 import signal
 import sys
 import threading
@@ -200,10 +201,22 @@ def test_cluster_errors_are_one_line(run, tmp_path, args, message):
     assert not (tmp_path / "c.png").exists()
 
 
-@pytest.mark.parametrize("command", ["render", "signature"])
+def test_warmup_takes_the_cluster_options_as_render_does(run):
+    import dask
+    with dask.config.set({"distributed.comm.timeouts.connect": "0.5s"}):
+        for args, message in [(["--cluster", "tcp://127.0.0.1:1"], "cannot reach the Dask scheduler at "
+                                                                   "tcp://127.0.0.1:1: Timed out"),
+                              (["--cluster-file", "nowhere.json"], "--cluster-file nowhere.json: file not found")]:
+            result = run("warmup", *args)
+            assert result.exit_code == 2 and result.output.startswith(f"error: {message}"), result.output
+            assert result.output.count("\n") == 1
+
+
+@pytest.mark.parametrize("command", [["render", "scene.yaml", "-o", "c.png"], ["signature", "scene.yaml", "-o", "c.png"],
+                                     ["warmup"]])
 def test_without_dask_the_error_names_the_extra(run, tmp_path, monkeypatch, command):
     monkeypatch.setitem(sys.modules, "distributed", None)                 # import distributed fails
-    result = run(command, "scene.yaml", "-o", "c.png", "--local-cluster", "2")
+    result = run(*command, "--local-cluster", "2")
     assert (result.exit_code, result.output) == (2, "error: a cluster needs Dask's distributed scheduler, which is "
                                                     "not installed: pip install -e '.[cluster]' in the rtcli folder "
                                                     "(rtcli is not on the package index)\n")
@@ -342,6 +355,20 @@ def test_render_prints_the_workers_notes_before_the_bar_ends(run, threads, compi
     assert err[:first].startswith("note: worker tcp://127.0.0.1:") and "\n" not in err[:first]
     assert first < err.index("100%")
     assert err.rstrip("\n").splitlines()[-1].endswith(" compiled the engine in 2.5 s (cached there for later renders)")
+
+
+def test_frames_on_a_cluster_tell_it_too(run, threads, compiling):
+    """A frame a task: each frame's engine start-up (here, each compiles for show) is told, and the
+    summary adds up each worker's seconds."""
+    heard, _ = compiling
+    heard.set()
+    result = run("render", "scene.yaml", "--frames", "1-2", "-o", "f_%d.png", "--cluster", threads.scheduler_address)
+    assert result.exit_code == 0, result.output
+    lines = result.stderr.splitlines()
+    assert [line.endswith(f": {COMPILING}") for line in lines[:2]] == [True, True]        # a note each frame
+    summary = [re.fullmatch(r"note: worker tcp://127\.0\.0\.1:\d+ compiled the engine in ([\d.]+) s "
+                            r"\(cached there for later renders\)", line) for line in lines[2:]]
+    assert summary and all(summary) and sum(float(m[1]) for m in summary) == 5.0
 
 
 def test_a_note_ends_the_progress_bar_line_it_comes_under(capsys):
