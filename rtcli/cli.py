@@ -112,28 +112,32 @@ def _check_outputs(outputs, inputs) -> None:
     check_outputs(outputs, inputs)
 
 
-def _cluster_options(command):
-    """--cluster, --cluster-file and --local-cluster (README.md, Clusters)."""
-    for option in reversed((
-            click.option("--cluster", metavar="tcp://HOST:PORT", callback=_not_empty,
-                         help="Render on the Dask cluster whose scheduler listens there (needs the extra "
-                              "`cluster`; --workers is then unused)."),
-            click.option("--cluster-file", metavar="SCHEDULER.json", callback=_not_empty,
-                         help="Render on the Dask cluster named by this scheduler file."),
-            click.option("--local-cluster", type=click.IntRange(1, 256), metavar="N",
-                         help="Render on a Dask cluster of N worker processes started on this machine."))):
-        command = option(command)
-    return command
+def _cluster_options(doing: str = "Render on", extra: str = " --workers is then unused."):
+    """--cluster, --cluster-file and --local-cluster (README.md, Clusters), their help saying what
+    the command does there."""
+    def add(command):
+        for option in reversed((
+                click.option("--cluster", metavar="tcp://HOST:PORT", callback=_not_empty,
+                             help=f"{doing} the Dask cluster whose scheduler listens there (needs the extra "
+                                  f"`cluster`).{extra}"),
+                click.option("--cluster-file", metavar="SCHEDULER.json", callback=_not_empty,
+                             help=f"{doing} the Dask cluster named by this scheduler file."),
+                click.option("--local-cluster", type=click.IntRange(1, 256), metavar="N",
+                             help=f"{doing} a Dask cluster of N worker processes started on this machine."))):
+            command = option(command)
+        return command
+    return add
 
 
 def _cluster(address, file, local):
     """The cluster the options name (a frames.Reach, to use in a `with` block), or None; rtcli.cluster
-    (and Dask) only when one is named."""
+    (and Dask) only when one is named. The workers' notes go to stderr above the progress bar."""
     if not (address or file or local):
         return None
+    from rtcli import runs
     from rtcli.cluster import target
     from rtcli.frames import Reach
-    return Reach(target(address, file, local))
+    return Reach(target(address, file, local), runs.note)
 
 
 @main.command()
@@ -171,7 +175,7 @@ def _cluster(address, file, local):
 @click.option("--skip-existing", is_flag=True, help="Leave the frames (or images) already written; render the rest.")
 @click.option("--keep-going", is_flag=True, help="Several scenes or a folder: when one is broken, print its error, "
                                                  "render the others, and exit 2 at the end.")
-@_cluster_options
+@_cluster_options()
 @click.option("--watch", is_flag=True, help="Render again whenever the scene or a file it reads changes; "
                                             "print each render's time; Ctrl-C ends.")
 def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
@@ -219,7 +223,6 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
         items, folder = batch.plan(list(scene_files), output, f".{view}.png" if view else ".png")
         if skip_existing:
             items = [item for item in items if not os.path.isfile(item.output)]
-        note = lambda text: click.echo(f"note: {text}", err=True)                  # noqa: E731
         current = {}
 
         def load(path):
@@ -240,7 +243,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
                                    bvh=not no_bvh, progress=show)
             return api.render(scene, width=width, height=height, engine=engine, workers=workers,
                               block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh, output=out,
-                              progress=show, notes=note)
+                              progress=show, notes=runs.note)
         if watch:
             return runs.watch_scene(items[0], load, render_one, stats, as_json)
         broken = []
@@ -269,7 +272,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
               help="One ray per N x N block, through its top-left pixel.")
 @click.option("--workers", type=click.IntRange(1, 256), help="Worker processes (default: all cores).")
 @click.option("--frame", type=click.IntRange(1), metavar="N", help="Frame N of an animated scene (default 1).")
-@_cluster_options
+@_cluster_options()
 def signature(scene_file, output, ids_out, legend, width, height, block_size, workers, frame,
               cluster, cluster_file, local_cluster):
     """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
@@ -444,11 +447,18 @@ def validate(scene_file, list_objects, strict):
 
 
 @main.command()
-def warmup():
+@_cluster_options("Warm every worker of", " This machine is not warmed.")
+def warmup(cluster, cluster_file, local_cluster):
     """Compile the render engine now (about a minute, once), or load it from numba's cache; say
-    where the cache is and how long it took. Renders then start at once."""
+    where the cache is and how long it took. Renders then start at once. With a cluster option:
+    on every worker of the cluster at once, a line for each."""
     import time
 
+    where = _cluster(cluster, cluster_file, local_cluster)
+    if where is not None:
+        from rtcli.cluster_engine import warm
+        with where:
+            return warm(where.session(), click.echo)
     from rtcli import machinecode, variants
     from rtcli.compiled.warmup import bytecode
     from rtcli.compiled.warmup import warmup as warm

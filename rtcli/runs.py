@@ -6,6 +6,7 @@ cluster, a watch, a debug view. cli.py parses the options and calls these.
 from __future__ import annotations
 
 import os
+import threading
 import time
 
 import click
@@ -28,14 +29,28 @@ def check_size(model, width, height) -> tuple[int, int, str | None]:
     return api.image_size(model, width, height, ("--width", "--height"))
 
 
+_terminal = threading.Lock()          # the progress bar and the notes share stderr's last line
+_bar_open = [False]                   # a progress bar's line is on stderr, not ended yet
+
+
 def progress_bar(enabled: bool, label: str):
     if not enabled:
         return None
 
     def show(done, total):
         bar = "#" * (30 * done // total)
-        click.echo(f"\r{label} [{bar:<30}] {100 * done // total:3d}%", err=True, nl=done == total)
+        with _terminal:
+            click.echo(f"\r{label} [{bar:<30}] {100 * done // total:3d}%", err=True, nl=done == total)
+            _bar_open[0] = done != total
     return show
+
+
+def note(text: str) -> None:
+    """A `note:` line on stderr, from any thread (a cluster's workers speak while the render runs):
+    below a progress bar's unfinished line, the bar going on on the next line."""
+    with _terminal:
+        click.echo(("\n" if _bar_open[0] else "") + f"note: {text}", err=True)
+        _bar_open[0] = False
 
 
 def make_job(model, width, height, block_size, **kw):
