@@ -2,23 +2,30 @@
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
-STAMP  := $(VENV)/.installed
+BASE   := $(VENV)/.installed-base
+FULL   := $(VENV)/.installed
 
 .PHONY: demo warmup test test-all golden bench clean
 
-$(STAMP): pyproject.toml
+# rtcli and its base dependencies: enough to render with the numpy engine.
+$(BASE): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e .
+	touch $(BASE)
+
+# Everything the tests use: numba (the compiled engine), FLIP, Dask, the test tools.
+$(FULL): $(BASE)
 	$(PY) -m pip install --quiet -e '.[test,fast,flip,cluster]'
-	touch $(STAMP)
+	touch $(FULL)
 
-# Compile the render engine once (about a minute; numba caches it), so no render waits for it.
-warmup: $(STAMP)
-	$(VENV)/bin/rtcli warmup
-
-demo: warmup
+# The first image at once, with the numpy engine: no numba to install or compile.
+demo: $(BASE)
 	$(VENV)/bin/rtcli render scenes/whitted.yaml -o whitted.png --stats
-	@echo "wrote whitted.png"
+	@echo "wrote whitted.png. Next: make warmup (numba's compiled engine, several times faster on big images; it compiles once)"
+
+# Compile the compiled engine once (numba caches it), so no render waits for it; it says how far it has got.
+warmup: $(FULL)
+	$(VENV)/bin/rtcli warmup
 
 test: warmup
 	$(PY) -m pytest -q -m "not slow"
@@ -26,7 +33,7 @@ test: warmup
 test-all: warmup
 	$(PY) -m pytest -q
 
-golden: $(STAMP)
+golden: $(FULL)
 	$(PY) -m pytest -q tests/test_golden.py --update-goldens
 
 bench: warmup

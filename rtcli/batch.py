@@ -6,7 +6,9 @@ names (default: the current one), NAME.png for NAME.yaml, in one process: the
 compiled engine's machine code is loaded once. Scenes are loaded one at a time
 (memory holds one scene and one image); each image is staged in a temporary file,
 and only when every scene has rendered are they all renamed into place, so a bad
-scene anywhere leaves no output (writer.Staged).
+scene anywhere leaves no output (writer.Staged). With --keep-going a broken scene
+(an error while loading or rendering it) is reported and left out, and the others'
+images are placed at the end (README.md, Commands).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.errors import RtcliError, shown
+from rtcli.errors import RtcliError, SceneError, error_line, shown
 from rtcli.writer import FORMATS
 
 SCENE_SUFFIXES = (".yaml", ".yml")
@@ -66,24 +68,33 @@ def _stem(path: str) -> str:
     return os.path.splitext(os.path.basename(path))[0]
 
 
-def run(items: list[Item], folder: str | None, load: Callable, render: Callable) -> list[tuple[Item, object, float]]:
+def run(items: list[Item], folder: str | None, load: Callable, render: Callable, *, ids: bool = False,
+        keep_going: Callable | None = None) -> list[tuple[Item, object, float]]:
     """Load and render each item, staging its image; all placed at the end, or none.
 
-    `load(path)` returns an api.Scene, `render(scene, label)` its 8-bit ImageArray.
-    Returns (item, RenderStats, seconds from loading to staging) per scene.
+    `load(path)` returns an api.Scene, `render(scene, label)` its 8-bit ImageArray (with `ids`,
+    its 16-bit id map). Returns (item, RenderStats, seconds from loading to staging) per scene.
+    `keep_going(item, error)`, when given, receives the error of each scene that fails to load
+    or render (RtcliError, MemoryError), which is then left out while the others are placed; the
+    folder made for them stays, even empty. An error about the outputs (one that is an input of
+    a scene, or cannot be written) still stops the run with nothing placed.
     """
     from rtcli.outputs import check_outputs
     from rtcli.writer import Staged
     made = make_folder(folder)
-    done, inputs, outputs = [], [], [(item.output, False) for item in items]
+    done, inputs, outputs = [], [], [(item.output, ids) for item in items]
     try:
         with Staged() as staged:
             for item in items:
                 start = time.perf_counter()
-                scene = load(item.scene)
+                scene = _attempt(item, keep_going, load, item.scene)
+                if scene is None:
+                    continue
                 inputs += scene.inputs
                 check_outputs(outputs, inputs)
-                image = render(scene, os.path.basename(item.scene))
+                image = _attempt(item, keep_going, render, scene, os.path.basename(item.scene))
+                if image is None:
+                    continue
                 staged.add(item.output, np.asarray(image))
                 done.append((item, image.stats, time.perf_counter() - start))
             staged.commit()
@@ -92,6 +103,26 @@ def run(items: list[Item], folder: str | None, load: Callable, render: Callable)
             remove_folder(folder)
         raise
     return done
+
+
+def _attempt(item: Item, keep_going: Callable | None, step: Callable, *args):
+    """step(*args); with keep_going, None once the error of a broken scene is passed to it."""
+    if keep_going is None:
+        return step(*args)
+    try:
+        return step(*args)
+    except (RtcliError, MemoryError) as error:
+        keep_going(item, error)
+        return None
+
+
+def broken_line(item: Item, error: BaseException) -> str:
+    """The error line of a scene --keep-going leaves out: a scene file's error is located in it; any
+    other names the scene first, unless it does already."""
+    line = error_line(error)
+    if isinstance(error, SceneError) or str(error).startswith(f"{shown(item.scene)}:"):
+        return line
+    return line.replace("error: ", f"error: {shown(item.scene)}: ", 1)
 
 
 def make_folder(folder: str | None) -> bool:

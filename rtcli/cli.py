@@ -17,7 +17,7 @@ import threading
 import click
 
 from rtcli import __version__
-from rtcli.errors import Interrupted, RtcliError, one_line, shown
+from rtcli.errors import Interrupted, RtcliError, error_line, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
 VIEWS = ("normal", "depth", "uv", "albedo", "bounces", "ids")          # rtcli/views.py, not imported to start
@@ -55,7 +55,7 @@ class RtcliGroup(click.Group):
         except (RtcliError, MemoryError) as e:
             if "--debug" in args:
                 raise
-            click.echo(f"error: {one_line(str(e) or 'out of memory')}", err=True)
+            click.echo(error_line(e), err=True)
             sys.exit(2)
         finally:
             restore()
@@ -115,28 +115,32 @@ def _check_outputs(outputs, inputs) -> None:
     check_outputs(outputs, inputs)
 
 
-def _cluster_options(command):
-    """--cluster, --cluster-file and --local-cluster (README.md, Clusters)."""
-    for option in reversed((
-            click.option("--cluster", metavar="tcp://HOST:PORT", callback=_not_empty,
-                         help="Render on the Dask cluster whose scheduler listens there (needs the extra "
-                              "`cluster`; --workers is then unused)."),
-            click.option("--cluster-file", metavar="SCHEDULER.json", callback=_not_empty,
-                         help="Render on the Dask cluster named by this scheduler file."),
-            click.option("--local-cluster", type=click.IntRange(1, 256), metavar="N",
-                         help="Render on a Dask cluster of N worker processes started on this machine."))):
-        command = option(command)
-    return command
+def _cluster_options(doing: str = "Render on", extra: str = " --workers is then unused."):
+    """--cluster, --cluster-file and --local-cluster (README.md, Clusters), their help saying what
+    the command does there."""
+    def add(command):
+        for option in reversed((
+                click.option("--cluster", metavar="tcp://HOST:PORT", callback=_not_empty,
+                             help=f"{doing} the Dask cluster whose scheduler listens there (needs the extra "
+                                  f"`cluster`).{extra}"),
+                click.option("--cluster-file", metavar="SCHEDULER.json", callback=_not_empty,
+                             help=f"{doing} the Dask cluster named by this scheduler file."),
+                click.option("--local-cluster", type=click.IntRange(1, 256), metavar="N",
+                             help=f"{doing} a Dask cluster of N worker processes started on this machine."))):
+            command = option(command)
+        return command
+    return add
 
 
 def _cluster(address, file, local):
     """The cluster the options name (a frames.Reach, to use in a `with` block), or None; rtcli.cluster
-    (and Dask) only when one is named."""
+    (and Dask) only when one is named. The workers' notes go to stderr above the progress bar."""
     if not (address or file or local):
         return None
+    from rtcli import runs
     from rtcli.cluster import target
     from rtcli.frames import Reach
-    return Reach(target(address, file, local))
+    return Reach(target(address, file, local), runs.note)
 
 
 @main.command()
@@ -174,12 +178,14 @@ def _cluster(address, file, local):
 @click.option("--skip-existing", is_flag=True, help="Leave the frames (or images) already written at the size "
                                                     "asked for; render the rest.")
 @click.option("--strict", is_flag=True, help="The scene's warnings (as validate prints them) are errors (exit 2).")
-@_cluster_options
+@click.option("--keep-going", is_flag=True, help="Several scenes or a folder: when one is broken, print its error, "
+                                                 "render the others, and exit 2 at the end.")
+@_cluster_options()
 @click.option("--watch", is_flag=True, help="Render again whenever the scene or a file it reads changes; "
                                             "print each render's time; Ctrl-C ends.")
 def render(scene_files, output, width, height, block_size, samples, max_depth, workers, tile,
            gamma, quiet, progress, stats, as_json, engine, no_bvh, view, frame_range, frame, movie, skip_existing,
-           strict, cluster, cluster_file, local_cluster, watch):
+           strict, keep_going, cluster, cluster_file, local_cluster, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
     from rtcli import api, batch, runs
@@ -207,6 +213,9 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
                                "frame pattern, a movie or --skip-existing")
     if watch and (cluster or cluster_file or local_cluster):
         raise click.UsageError("--watch renders on this machine: it takes no cluster option")
+    if keep_going and (watch or sequence):
+        raise click.UsageError("--keep-going renders the other scenes when one is broken: it takes no --watch, "
+                               "--frames, frame pattern or movie")
     where = _cluster(cluster, cluster_file, local_cluster)
     bar = not quiet and (progress or sys.stderr.isatty())
     lint = runs.lint(quiet, strict, several, watch)
@@ -220,7 +229,6 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
         items, folder = batch.plan(list(scene_files), output, f".{view}.png" if view else ".png")
         if skip_existing:
             items = runs.missing(items, width, height)
-        note = lambda text: click.echo(f"note: {text}", err=True)                  # noqa: E731
         current = {}
 
         def load(path):
@@ -242,12 +250,20 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
                                    bvh=not no_bvh, progress=show)
             return api.render(scene, width=width, height=height, engine=engine, workers=workers,
                               block_size=block_size, tile=tile, gamma=gamma, bvh=not no_bvh, output=out,
-                              progress=show, notes=note)
+                              progress=show, notes=runs.note)
         if watch:
             return runs.watch_scene(items[0], load, render_one, stats, as_json)
-        done = batch.run(items, folder, load, render_one) if items else []
+        broken = []
+
+        def skip(item, error):
+            broken.append(item)
+            click.echo(batch.broken_line(item, error), err=True)
+        done = batch.run(items, folder, load, render_one, ids=view == "ids",
+                         keep_going=skip if keep_going else None) if items else []
     for line in batch.stats_lines(done, as_json, folder is not None) if stats else ():
         click.echo(line)
+    if broken:
+        raise click.exceptions.Exit(2)
 
 
 @main.command()
@@ -263,7 +279,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
               help="One ray per N x N block, through its top-left pixel.")
 @click.option("--workers", type=click.IntRange(1, 256), help="Worker processes (default: all cores).")
 @click.option("--frame", type=click.IntRange(1), metavar="N", help="Frame N of an animated scene (default 1).")
-@_cluster_options
+@_cluster_options()
 def signature(scene_file, output, ids_out, legend, width, height, block_size, workers, frame,
               cluster, cluster_file, local_cluster):
     """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
@@ -397,15 +413,13 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
 def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
     """Whether compare is given two folders; a usage error for a folder and a file, or for options
     of the other mode."""
-    folders = os.path.isdir(actual), os.path.isdir(expected)
-    if folders[0] != folders[1]:
-        raise click.UsageError(f"{shown(actual if folders[0] else expected)} is a folder: compare two folders "
-                               "or two images")
-    if folders[0] and pair_options:
+    from rtcli.compare_dirs import are_folders
+    folders = are_folders(actual, expected)
+    if folders and pair_options:
         raise click.UsageError("--diff, --flip and --ids compare two images; two folders get --report")
-    if not folders[0] and folder_options:
+    if not folders and folder_options:
         raise click.UsageError("--report and --junit compare two folders")
-    return folders[0]
+    return folders
 
 
 @main.command()
@@ -433,11 +447,18 @@ def validate(scene_file, list_objects, strict):
 
 
 @main.command()
-def warmup():
+@_cluster_options("Warm every worker of", " This machine is not warmed.")
+def warmup(cluster, cluster_file, local_cluster):
     """Compile the render engine now (about a minute, once), or load it from numba's cache; say
-    where the cache is and how long it took. Renders then start at once."""
+    where the cache is and how long it took. Renders then start at once. With a cluster option:
+    on every worker of the cluster at once, a line for each."""
     import time
 
+    where = _cluster(cluster, cluster_file, local_cluster)
+    if where is not None:
+        from rtcli.cluster_engine import warm
+        with where:
+            return warm(where.session(), click.echo)
     from rtcli import machinecode, variants
     from rtcli.compiled.warmup import bytecode
     from rtcli.compiled.warmup import warmup as warm

@@ -20,6 +20,9 @@ Workers must run the same rtcli and libraries as the client, or pixels could dif
 the client compares every worker's `fingerprint()` with its own when it connects,
 and every task compares it again where it runs (for workers that join later).
 
+A worker that compiles the engine says so to the client while it does, and the client
+says after the render which workers compiled and for how long (rtcli/cluster_engine.py).
+
 distributed is imported only here, and this module only when a cluster option is
 given.
 """
@@ -41,6 +44,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rtcli import __version__
+from rtcli.cluster_engine import TOPIC, Heard, told
 from rtcli.errors import RtcliError, plural, shown
 
 RAYS_PER_TASK = 2_000_000         # primary rays a task traces, at most (unless that leaves workers idle)
@@ -223,13 +227,12 @@ def _worker_address() -> str:
 
 def tiles_task(spec: dict, blobs: dict, frame: int, job, traced: int, tiles: list) -> list:
     """Trace a group of tiles of `frame`: [(rows, cols, values, stats)], as rtcli.render.run_tiles."""
-    from rtcli.render import prepare, run_tiles
+    from rtcli.render import run_tiles
     try:
         _checked(spec)
         with _lock:
             key = (spec["key"], frame, tuple(sorted(spec["overrides"].items())), job, traced)
-            scene, engine = _kept(_scenes, key, lambda: _prepared(spec, blobs, frame, job, traced, prepare),
-                                  KEPT_SCENES)
+            scene, engine = _kept(_scenes, key, lambda: _prepared(spec, blobs, frame, job, traced), KEPT_SCENES)
         results = run_tiles(scene, engine, job, tiles)
         for *_, stats in results:
             stats.engine = "compiled" if engine else "numpy"
@@ -238,9 +241,14 @@ def tiles_task(spec: dict, blobs: dict, frame: int, job, traced: int, tiles: lis
         raise RtcliError(str(e)) from None
 
 
-def _prepared(spec, blobs, frame, job, traced, prepare):
-    scene = _scene(spec, blobs, frame)
-    return scene, prepare(scene, job, traced)[0]
+def _prepared(spec, blobs, frame, job, traced):
+    """(scene, engine) of `frame`; the engine's notes, and its compile time, told to the client."""
+    from rtcli.render import prepare
+    scene, notes = _scene(spec, blobs, frame), told()
+    engine, load = prepare(scene, job, traced, notes)
+    if notes and load:
+        notes.compiled(load.compile_seconds)
+    return scene, engine
 
 
 def frame_task(spec: dict, blobs: dict, frame: int, job):
@@ -250,7 +258,10 @@ def frame_task(spec: dict, blobs: dict, frame: int, job):
         _checked(spec)
         with _lock:
             scene = _scene(spec, blobs, frame)
-        image, stats = render(scene, job, 1)
+        notes = told()
+        image, stats = render(scene, job, 1, notes=notes)
+        if notes:
+            notes.compiled(stats.compile_seconds)
         return frame, image, stats
     except RtcliError as e:
         raise RtcliError(str(e)) from None
@@ -267,10 +278,13 @@ def groups(tiles: list, samples: int, threads: int) -> list[list]:
 
 
 class Session:
-    """A connection to the cluster for one command: `with Session(target) as s: ...`."""
+    """A connection to the cluster for one command: `with Session(target) as s: ...`. `notes` hears
+    what the workers say about their engine, as they say it (default: stderr; cluster_engine.Heard)."""
 
-    def __init__(self, where: Target):
+    def __init__(self, where: Target, notes=None):
+        from rtcli.compiled.loading import say
         self.where, self.client, self.cluster, self.futures = where, None, None, []
+        self.heard = Heard(notes or say)
         self._quiet = contextlib.ExitStack()
 
     def __enter__(self) -> Session:
@@ -278,6 +292,7 @@ class Session:
         self._quiet.enter_context(_quiet())
         try:
             self._connect(distributed)
+            self.client.subscribe_topic(TOPIC, self.heard)       # before any task: no note is missed
             self._check_workers()
         except BaseException:
             self.__exit__(None, None, None)
@@ -302,7 +317,7 @@ class Session:
         """Refuse workers whose software differs; wait a while for a first worker."""
         distributed = _distributed()
         try:
-            self.client.wait_for_workers(1, timeout=_timeout())
+            self.client.wait_for_workers(1, timeout=connect_timeout())
         except (TimeoutError, distributed.TimeoutError):
             raise RtcliError(f"{self.where} has no workers (start some: README.md, Clusters)") from None
         try:
@@ -356,12 +371,23 @@ class Session:
                         for k in frames]
         yield from self._finished()
 
+    def run(self, function, *args) -> dict:
+        """`function(*args)` on every worker at once (Client.run): {worker address: its result, or the
+        exception it raised}."""
+        distributed = _distributed()
+        try:
+            return self.client.run(function, *args, on_error="return")
+        except (distributed.CancelledError, OSError) as e:
+            raise RtcliError(f"lost {self.where} ({type(e).__name__})") from None
+
     def _finished(self):
+        """The futures' results as they finish; then which workers compiled the engine meanwhile."""
         distributed = _distributed()
         try:
             for future in distributed.as_completed(self.futures, loop=self.client.loop):
                 yield future.result()
                 future.release()
+            self.heard.summary()
         except distributed.KilledWorker as e:
             raise RtcliError(f"a task of this render kept killing its workers (out of memory?): {e}") from None
         except (distributed.CancelledError, OSError) as e:
@@ -387,7 +413,7 @@ def _sigint_ignored():
         signal.signal(signal.SIGINT, previous)
 
 
-def _timeout() -> float:
+def connect_timeout() -> float:
     """Dask's connect timeout (distributed.comm.timeouts.connect), in seconds."""
     import dask
     from dask.utils import parse_timedelta

@@ -42,6 +42,21 @@ def compare_dirs(actual: str, expected: str, image_options: dict, id_options: di
     return all(pair.ok for pair in pairs)
 
 
+def are_folders(actual: str, expected: str) -> bool:
+    """Whether compare is given two folders (else two images). RtcliError naming the argument
+    that does not exist, or both for a folder and a file."""
+    for path, other in ((actual, expected), (expected, actual)):
+        if not os.path.lexists(path):
+            what = (f"folder (to compare with the folder {shown(other)})" if os.path.isdir(other)
+                    else "file" if os.path.lexists(other) else "file or folder")
+            raise RtcliError(f"{shown(path)}: no such {what}")
+    folders = os.path.isdir(actual), os.path.isdir(expected)
+    if folders[0] != folders[1]:
+        folder, other = (actual, expected) if folders[0] else (expected, actual)
+        raise RtcliError(f"{shown(folder)} is a folder but {shown(other)} is not: compare two folders or two images")
+    return folders[0]
+
+
 def _check_outputs(actual: str, expected: str, report: str | None, junit: str | None) -> None:
     from rtcli.outputs import check_file_output
     from rtcli.report import check_report_dir

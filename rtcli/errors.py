@@ -49,6 +49,11 @@ def one_line(message: str) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
 
 
+def error_line(error: BaseException) -> str:
+    """The line rtcli prints for an error (RtcliError, MemoryError): `error: ` and its message."""
+    return f"error: {one_line(str(error) or 'out of memory')}"
+
+
 class Interrupted(BaseException):
     """SIGINT or SIGTERM arrived: unwind (workers stopped, temporary files removed); exit 128 + signum."""
 

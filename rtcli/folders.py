@@ -6,7 +6,10 @@ compare` on two files does (a color image, or a 16-bit signature id map). A pair
 is ok, failing, missing (no actual image for an expected one), extra (an actual
 image without an expected one) or unreadable (a file that is not a readable PNG);
 anything but ok fails the run. An unreadable file fails its pair, not the run, so
-one broken image still gets every other pair compared and reported.
+one broken image still gets every other pair compared and reported. A missing or
+unreadable pair is an error (it could not be compared: a scene that failed to render
+leaves its golden without an image), a failing or extra one a failure (README.md,
+Commands; the JUnit file and the report tell them apart).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from rtcli import compare as gate
 from rtcli.errors import RtcliError, one_line, plural, shown
 
 RANK = {"unreadable": 0, "missing": 1, "extra": 2, "failing": 3, "ok": 4}      # worst first
+ERRORS = ("unreadable", "missing")                # not compared; the other statuses but ok are failures
 
 
 @dataclass(frozen=True)
@@ -38,6 +42,11 @@ class Pair:
     @property
     def ok(self) -> bool:
         return self.status == "ok"
+
+    @property
+    def result(self) -> str:
+        """"ok", "error" (the pair could not be compared) or "failure" (see the module docstring)."""
+        return "ok" if self.ok else "error" if self.status in ERRORS else "failure"
 
     def severity(self) -> tuple:
         """Sort key, worst first: status, then bad pixels, then mean error."""

@@ -87,15 +87,16 @@ def apply(scene, changes: dict):
 class Reach:
     """The cluster of one command (a cluster.Target), connected when a render first needs it and
     closed at the end of the `with` block: the scenes of a run share one connection (and one
-    --local-cluster), and a run with nothing to render reaches no cluster."""
+    --local-cluster), and a run with nothing to render reaches no cluster. `notes` hears what the
+    workers say about their engine (cluster.Session)."""
 
-    def __init__(self, target):
-        self.target, self._session, self._stack = target, None, contextlib.ExitStack()
+    def __init__(self, target, notes=None):
+        self.target, self.notes, self._session, self._stack = target, notes, None, contextlib.ExitStack()
 
     def session(self):
         if self._session is None:
             from rtcli.cluster import Session
-            self._session = self._stack.enter_context(Session(self.target))
+            self._session = self._stack.enter_context(Session(self.target, self.notes))
         return self._session
 
     def __enter__(self) -> Reach:

@@ -1,8 +1,9 @@
 """The JUnit XML file of `rtcli compare ... --junit FILE`, which CI systems show as test results.
 
 One test suite, one test case per pair (named by its relative path): an ok pair
-passes, a failing, missing or extra one is a <failure> whose message is its summary
-line, an unreadable one an <error>. The file follows the Apache Ant JUnit schema,
+passes, a failing or extra one is a <failure> whose message is its summary line, a
+missing or unreadable one (it could not be compared: no render, or a broken file) an
+<error> (folders.Pair.result). The file follows the Apache Ant JUnit schema,
 the strictest of the common ones (every attribute it requires, <properties>,
 <system-out> and <system-err>), so the looser readers of GitLab, Jenkins or GitHub
 actions read it too. Text is kept on one line and free of the control characters
@@ -16,19 +17,19 @@ import socket
 import xml.etree.ElementTree as ET
 
 from rtcli.errors import one_line
-from rtcli.folders import Pair, counts, total_line
+from rtcli.folders import Pair, total_line
 from rtcli.writer import write_atomic
 
 
 def junit_xml(pairs: list[Pair], properties: dict[str, str], seconds: float) -> bytes:
     """The document, as UTF-8 bytes."""
-    c = counts(pairs)
+    results = [pair.result for pair in pairs]
     suite = ET.Element("testsuite", {
         "name": "rtcli compare", "package": "rtcli", "id": "0",
         "timestamp": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%S"),
         "hostname": one_line(socket.gethostname()) or "localhost",
-        "tests": str(len(pairs)), "failures": str(c["failing"] + c["missing"] + c["extra"]),
-        "errors": str(c["unreadable"]), "skipped": "0", "time": f"{seconds:.3f}"})
+        "tests": str(len(pairs)), "failures": str(results.count("failure")),
+        "errors": str(results.count("error")), "skipped": "0", "time": f"{seconds:.3f}"})
     listed = ET.SubElement(suite, "properties")
     for name, value in properties.items():
         ET.SubElement(listed, "property", {"name": name, "value": one_line(value)})
@@ -36,8 +37,7 @@ def junit_xml(pairs: list[Pair], properties: dict[str, str], seconds: float) -> 
         case = ET.SubElement(suite, "testcase", {"name": one_line(pair.path), "classname": "rtcli.compare",
                                                  "time": f"{pair.seconds:.3f}"})
         if not pair.ok:
-            kind = "error" if pair.status == "unreadable" else "failure"
-            result = ET.SubElement(case, kind, {"message": one_line(pair.summary), "type": pair.status})
+            result = ET.SubElement(case, pair.result, {"message": one_line(pair.summary), "type": pair.status})
             result.text = one_line(pair.summary)
     ET.SubElement(suite, "system-out").text = total_line(pairs)
     ET.SubElement(suite, "system-err").text = ""

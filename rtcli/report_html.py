@@ -1,8 +1,9 @@
 """The page of a comparison report (report.py): one table row per pair, in the order given.
 
 Plain HTML with its style inline: it loads only the pictures beside it. Every text
-from outside (paths, summaries) is escaped. Rows carry the class `pair` and their
-status, so a reader (or a test in a browser) can count them; a small script marks a
+from outside (paths, summaries) is escaped. Rows carry the class `pair`, their status
+and, unless ok, their result (`error`: not compared, such as a golden without a render,
+shown with the golden; `failure`), so a reader (or a test in a browser) can count them; a small script marks a
 picture that did not load with the class `broken` and counts those that did in the
 body's `data-images-loaded`.
 """
@@ -23,6 +24,8 @@ img.broken { outline: 3px solid #d00; min-width: 40px; min-height: 30px; }
 .summary { font-family: monospace; font-size: 12px; max-width: 24em; }
 .status { display: inline-block; padding: 0 6px; border-radius: 3px; color: #fff; background: #c00; }
 .ok .status { background: #080; }
+.error .status { background: #d06000; }
+.result { margin-left: 4px; font-size: 12px; color: #555; }
 .total { font-weight: bold; }
 """
 
@@ -52,7 +55,8 @@ def page(rows: list[Pair], pictures: dict, titles: tuple[str, str], gate_text: s
 <h1>rtcli compare</h1>
 <p class="total">{escape(total_line(rows))}</p>
 <p>actual: <code>{actual}</code>, expected: <code>{expected}</code>; {escape(gate_text)}.
-Rows are worst first.</p>
+Rows are worst first: errors (a pair that could not be compared: an expected image without an
+actual one, such as a scene that failed to render, or an unreadable file), then failures.</p>
 <table>
 <thead><tr><th>image</th>{head}</tr></thead>
 <tbody>
@@ -66,8 +70,9 @@ Rows are worst first.</p>
 def _row(k: int, pair: Pair, names: dict, columns: list[str]) -> str:
     cells = "".join(_cell(names.get(c), c, pair.path) for c in columns)
     flip = f"<div>mean FLIP {pair.flip_mean:.4f}</div>" if pair.flip_mean is not None else ""
-    return (f'<tr class="pair {pair.status}" id="pair-{k}"><td><div class="path">{escape(pair.path)}</div>'
-            f'<span class="status">{escape(pair.status)}</span>'
+    kind, result = ("", "") if pair.ok else (f" {pair.result}", f'<span class="result">{pair.result}</span>')
+    return (f'<tr class="pair {pair.status}{kind}" id="pair-{k}"><td><div class="path">{escape(pair.path)}</div>'
+            f'<span class="status">{escape(pair.status)}</span>{result}'
             f'<div class="summary">{escape(pair.summary)}</div>{flip}</td>{cells}</tr>')
 
 

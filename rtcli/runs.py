@@ -6,6 +6,7 @@ still traced on a cluster, a watch, a debug view. cli.py parses the options and 
 from __future__ import annotations
 
 import os
+import threading
 import time
 
 import click
@@ -28,14 +29,28 @@ def check_size(model, width, height) -> tuple[int, int, str | None]:
     return api.image_size(model, width, height, ("--width", "--height"))
 
 
+_terminal = threading.Lock()          # the progress bar and the notes share stderr's last line
+_bar_open = [False]                   # a progress bar's line is on stderr, not ended yet
+
+
 def progress_bar(enabled: bool, label: str):
     if not enabled:
         return None
 
     def show(done, total):
         bar = "#" * (30 * done // total)
-        click.echo(f"\r{label} [{bar:<30}] {100 * done // total:3d}%", err=True, nl=done == total)
+        with _terminal:
+            click.echo(f"\r{label} [{bar:<30}] {100 * done // total:3d}%", err=True, nl=done == total)
+            _bar_open[0] = done != total
     return show
+
+
+def note(text: str) -> None:
+    """A `note:` line on stderr, from any thread (a cluster's workers speak while the render runs):
+    below a progress bar's unfinished line, the bar going on on the next line."""
+    with _terminal:
+        click.echo(("\n" if _bar_open[0] else "") + f"note: {text}", err=True)
+        _bar_open[0] = False
 
 
 def lint(quiet: bool, strict: bool, several: bool, watch: bool):
@@ -165,9 +180,10 @@ def missing(items: list, width, height) -> list:
 
 
 def view(scene, kind: str, width, height, tile: int, label: str | None):
-    """A debug view's picture (rtcli/views.py), its summary line printed."""
+    """A debug view's picture (rtcli/views.py), its summary line printed; the ids view as its id
+    map, which `rtcli compare --ids` reads (README.md, Commands)."""
     from rtcli.results import ImageArray
     from rtcli.views import summary, view
     data = view(scene, kind, width=width, height=height, tile=tile)
     click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
-    return ImageArray(data.to_8bit(), inputs=scene.inputs)
+    return data if data.is_ids else ImageArray(data.to_8bit(), inputs=scene.inputs)

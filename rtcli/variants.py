@@ -25,11 +25,13 @@ written twice. `@per_ray` marks code that only makes sense for one ray (a BVH
 walk, the integrator loop): it has python and compiled variants but no numpy one.
 
 Bit for bit: the scalar variants do the numpy variant's floating-point operations in
-the same order, and IEEE arithmetic and sqrt are exact, so they agree to the last
-bit, with one documented exception. numpy may take x ** y, arccos, arcsin, arctan2
-and cbrt from its own SIMD library (Intel SVML, on AVX-512 CPUs) where both scalar
-variants call the C library: those five can differ by 1 ulp (unit in the last place)
-between the numpy and the scalar variants. cos, floor, sqrt and the rest agree.
+the same order, and the vocabulary holds only operations that IEEE defines to the last
+bit (arithmetic, sqrt, floor, frexp, ldexp, comparisons), so they agree to the last bit,
+and so do CPUs of every kind. Kernels take no math from numpy or the C library:
+numpy's x ** y, arccos, arcsin, arctan2 and cbrt come from Intel's SVML on AVX-512 CPUs
+and differ from the C library's in the last bit. rtcli's own elementary functions,
+kernels themselves, are in rtcli/core/elementary.py, and `foreign_math` finds any
+other (a test checks every kernel).
 
 Compiled-variant options (measured on the bench scenes; docs/architecture.md):
 error_model="numpy" (x / 0 is inf or nan, as in numpy, instead of raising), no
@@ -185,14 +187,14 @@ def u64(k):
     return np.asarray(k).astype(np.uint64)
 
 
-sqrt, floor, cbrt, cos = np.sqrt, np.floor, np.cbrt, np.cos
-arccos, arcsin, arctan2 = np.arccos, np.arcsin, np.arctan2
+sqrt, floor = np.sqrt, np.floor
+frexp, ldexp = np.frexp, np.ldexp             # x = m 2^e, m in [0.5, 1); m 2^e (e an integer)
 minimum, maximum = np.minimum, np.maximum     # NaN in, NaN out
 fmin, fmax = np.fmin, np.fmax                 # a NaN operand is ignored
 copysign, isfinite, isnan = np.copysign, np.isfinite, np.isnan
 
-VOCABULARY = ("select", "not_", "narrow", "to_int", "bits", "u64", "sqrt", "floor", "cbrt", "cos", "arccos", "arcsin",
-              "arctan2", "minimum", "maximum", "fmin", "fmax", "copysign", "isfinite", "isnan")
+VOCABULARY = ("select", "not_", "narrow", "to_int", "bits", "u64", "sqrt", "floor", "frexp", "ldexp", "minimum",
+              "maximum", "fmin", "fmax", "copysign", "isfinite", "isnan")
 
 
 # --- the scalar variant of each op (plain Python; numba compiles the same functions) ---
@@ -267,20 +269,27 @@ def _libm(f):
     return call
 
 
+def _frexp(x):
+    m, e = math.frexp(x)
+    return np.float64(m), e
+
+
+def _ldexp(m, e):
+    try:
+        return np.float64(math.ldexp(m, e))
+    except OverflowError:
+        return np.float64(math.copysign(math.inf, m))
+
+
 _SCALAR = dict(select=_select, not_=_not, narrow=_narrow, to_int=_to_int, bits=_bits, u64=_u64, floor=np.floor,
-               minimum=_minimum, maximum=_maximum, fmin=_fmin, fmax=_fmax, isfinite=math.isfinite,
-               isnan=math.isnan, **{name: _libm(f) for name, f in
-                                    dict(sqrt=math.sqrt, cos=math.cos, arccos=math.acos, arcsin=math.asin,
-                                         arctan2=math.atan2, copysign=math.copysign,
-                                         cbrt=getattr(math, "cbrt", lambda x: math.copysign(abs(x) ** (1 / 3), x))
-                                         ).items()})
-
-
-_LIBM = ("sqrt", "cos", "arccos", "arcsin", "arctan2", "copysign", "cbrt")
+               frexp=_frexp, ldexp=_ldexp, minimum=_minimum, maximum=_maximum, fmin=_fmin, fmax=_fmax,
+               isfinite=math.isfinite, isnan=math.isnan, sqrt=_libm(math.sqrt), copysign=_libm(math.copysign))
+_EXACT_LIBM = ("sqrt", "copysign", "frexp", "ldexp")   # exact on any CPU; numba's own (below)
 
 
 def _numba_ops() -> dict:
-    """The scalar ops as numba sees them: the same functions compiled, libm for the math."""
+    """The scalar ops as numba sees them: the same functions compiled; sqrt and copysign as LLVM's,
+    frexp and ldexp from the bits."""
     from numba import njit
     from numba import types as nt
     from numba.extending import intrinsic
@@ -292,15 +301,46 @@ def _numba_ops() -> dict:
             return builder.bitcast(args[0], ir.IntType(64))
         return nt.uint64(nt.float64), codegen
 
-    def cube_root(x):
-        return np.cbrt(x)
+    @intrinsic
+    def bits_float(typingctx, b):
+        def codegen(context, builder, signature, args):
+            from llvmlite import ir
+            return builder.bitcast(args[0], ir.DoubleType())
+        return nt.float64(nt.uint64), codegen
+
+    def frexp(x):
+        """math.frexp from the bits (numba's own calls a helper of its runtime)."""
+        if x == 0 or x != x or x - x != 0:                   # zero, nan, inf
+            return x, 0
+        scale = 0
+        if abs(x) < _TINY:                                   # subnormal: normal first
+            x, scale = x * _TWO_54, 54
+        b = float_bits(x)
+        e = np.int64((b >> np.uint64(52)) & np.uint64(0x7FF))
+        return bits_float((b & np.uint64(0x800FFFFFFFFFFFFF)) | np.uint64(0x3FE0000000000000)), e - 1022 - scale
+
+    def ldexp(x, n):
+        """math.ldexp by at most three products with powers of 2, only the last of them rounded (the
+        others keep x normal), as the C library's scalbn does."""
+        if n > 1023:
+            x, n = x * _TWO_1023, n - 1023
+            if n > 1023:
+                x, n = x * _TWO_1023, min(n - 1023, 1023)
+        elif n < -1022:
+            x, n = x * _TWO_M969, n + 969
+            if n < -1022:
+                x, n = x * _TWO_M969, max(n + 969, -1022)
+        return x * bits_float(np.uint64(n + 1023) << np.uint64(52))
 
     small = njit(inline="always", error_model="numpy", _nrt=False)
-    ops = {name: small(f) for name, f in _SCALAR.items() if f.__module__ == __name__ and name not in _LIBM}
-    ops.update(sqrt=math.sqrt, floor=np.floor, cos=math.cos, arccos=math.acos, arcsin=math.asin,
-               arctan2=math.atan2, copysign=math.copysign, isfinite=math.isfinite, isnan=math.isnan,
-               bits=float_bits, cbrt=small(cube_root))
+    ops = {name: small(f) for name, f in _SCALAR.items() if f.__module__ == __name__ and name not in _EXACT_LIBM}
+    ops.update(sqrt=math.sqrt, floor=np.floor, frexp=small(frexp), ldexp=small(ldexp), copysign=math.copysign,
+               isfinite=math.isfinite, isnan=math.isnan, bits=float_bits)
     return ops
+
+
+_TINY, _TWO_54 = float.fromhex("0x1p-1022"), float.fromhex("0x1p54")
+_TWO_1023, _TWO_M969 = float.fromhex("0x1p1023"), float.fromhex("0x1p-969")
 
 
 # --- kernels and their variants ---
@@ -431,25 +471,36 @@ def _start_numba() -> None:
     _started = True
 
 
-INEXACT = ("arccos", "arcsin", "arctan2", "cbrt")        # numpy may take these (and x ** y) from SVML
+EXACT = frozenset(VOCABULARY)
 
 
-def inexact(f, seen=None) -> set:
-    """The functions f (or a kernel it calls) uses whose numpy variant may differ from the C
-    library's by an ulp: some of INEXACT, and "**" for x ** y."""
+def foreign_math(f, seen=None) -> set:
+    """What f, or a kernel it calls, takes from numpy or the C library beyond the exact ops of the
+    vocabulary: x ** y, or a function such as np.exp or math.atan2. Their numpy and C-library
+    versions may differ in the last bit (numpy takes some from Intel's SVML on AVX-512 CPUs), so the
+    variants could too; rtcli's own are in rtcli/core/elementary.py. Empty for every kernel (tested)."""
     seen = set() if seen is None else seen
     if f in seen:
         return set()
     seen.add(f)
-    found = {"**"} if any(i.opname == "BINARY_POWER" or (i.opname == "BINARY_OP" and i.argrepr == "**")
-                          for i in dis.get_instructions(f)) else set()
-    for name in f.__code__.co_names:
-        value = f.__globals__.get(name)
-        if name in INEXACT and value is globals()[name]:
-            found.add(name)
-        elif is_kernel(value):
-            found |= inexact(value, seen)
+    found, module = set(), None
+    for i in dis.get_instructions(f):
+        if i.opname == "BINARY_POWER" or (i.opname == "BINARY_OP" and i.argrepr in ("**", "**=")):
+            found.add("**")
+        elif i.opname in ("LOAD_ATTR", "LOAD_METHOD") and module is not None:
+            attribute = getattr(module, i.argval, None)
+            if callable(attribute) and not isinstance(attribute, type) and i.argval not in EXACT:
+                found.add(f"{module.__name__}.{i.argval}")
+        value = f.__globals__.get(i.argval) if i.opname == "LOAD_GLOBAL" else None
+        module = value if value is np or value is math else None
+        if is_kernel(value):
+            found |= foreign_math(value, seen)
+        elif isinstance(value, (np.ufunc, types.BuiltinFunctionType)) and not any(value is v for v in _ALLOWED):
+            found.add(i.argval)
     return found
+
+
+_ALLOWED = [globals()[name] for name in VOCABULARY]
 
 
 def variants_made() -> list:

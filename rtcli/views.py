@@ -3,7 +3,8 @@
 The rays are traced by the numpy engine's own functions (intersect.find_first_hit,
 intersect.surface, trace.trace), so a view shows exactly what the render sees. Views are
 computed tile by tile in this process and returned as ImageArrays of data, whose `picture`
-is how they show (in Jupyter, and the PNG that `rtcli render --view` writes):
+is how they show (in Jupyter, and the PNG that `rtcli render --view` writes; for ids, which
+show as the signature's colors, the PNG is the 16-bit id map that `rtcli compare --ids` reads):
 
     normal   float64 (H, W, 3): the unit shading normal on the outside of the surface (the side
              its geometric normal points to), 0 on a miss; shown as (n + 1) / 2, so a face seen
@@ -158,7 +159,8 @@ def summary(data: np.ndarray, kind: str, max_depth: int = 5) -> str:
                 f"v {v.min():.4g} to {v.max():.4g}; {_missed(pixels - int(seen.sum()))} (blue)")
     return {"normal": "normal: color = (n + 1) / 2 of the outward shading normal; black: a miss",
             "albedo": "albedo: kd T of the first hit; black: a miss",
-            "ids": "ids: the signature's colors, one per object"}[kind]
+            "ids": f"ids: the signature's ids, 0 (background) to {int(data.max(initial=0))}, as a 16-bit id map "
+                   "(rtcli signature draws them in colors)"}[kind]
 
 
 def _missed(n: int) -> str:

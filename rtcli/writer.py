@@ -17,12 +17,13 @@ import tempfile
 import numpy as np
 from PIL import Image
 
+from rtcli.core.elementary import power
 from rtcli.errors import RtcliError, quoted, shown
 
 
 def srgb_encode(c: np.ndarray) -> np.ndarray:
     """The sRGB transfer function on linear values in [0, 1]."""
-    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(np.maximum(c, 0.0031308), 1 / 2.4) - 0.055)
+    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * power(np.maximum(c, 0.0031308), 1 / 2.4) - 0.055)
 
 
 def to_8bit(image: np.ndarray, gamma: bool = False) -> np.ndarray:

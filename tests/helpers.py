@@ -5,6 +5,9 @@ Tests import them as `from helpers import ...` (pytest puts tests/ on the path).
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import textwrap
 
 import numpy as np
@@ -45,3 +48,23 @@ def one_pixel(scene, i: int = 0, j: int = 0, width=None, height=None) -> np.ndar
     job = Job(width or scene.settings.width, height or scene.settings.height)
     color, _ = render_tile(scene, job, np.array([i]), np.array([j]))
     return color[0]
+
+
+# --- numpy's two code paths: with and without AVX-512 (where it takes some math from SVML) ---
+def avx512_features() -> list[str]:
+    """numpy's AVX-512 code paths this CPU takes, as NPY_DISABLE_CPU_FEATURES names them."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    except ImportError:
+        from numpy.core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    return [f for f in __cpu_dispatch__ if ("512" in f or f == "X86_V4") and __cpu_features__.get(f)]
+
+
+def without_avx512(args: list[str], **kwargs) -> subprocess.CompletedProcess:
+    """Run `python ARGS` in a process whose numpy does not take its AVX-512 paths, with tests/ on
+    its path (on a CPU without AVX-512, numpy's only path)."""
+    env = dict(os.environ, NPY_DISABLE_CPU_FEATURES=" ".join(avx512_features()),
+               PYTHONPATH=os.pathsep.join([os.path.dirname(__file__), os.environ.get("PYTHONPATH", "")]))
+    done = subprocess.run([sys.executable, *args], env=env, capture_output=True, text=True, timeout=600, **kwargs)
+    assert done.returncode == 0, done.stderr
+    return done

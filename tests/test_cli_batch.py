@@ -76,6 +76,73 @@ def test_a_bad_scene_among_many_leaves_no_output(run, tmp_path):
     assert list((tmp_path / "kept").iterdir()) == []
 
 
+BAD = SCENE.replace("radius: 1", "radius: -1") % "1, 1, 1"
+
+
+def test_keep_going_renders_the_good_scenes_of_a_folder_and_exits_2(run, tmp_path):
+    """A broken scene beside good ones: the good ones are written, one error line for the broken
+    one, exit 2; stdout holds only the JSON lines of the rendered scenes."""
+    (tmp_path / "bad.yaml").write_text(BAD)
+    result = CliRunner().invoke(main, ["render", ".", "-o", "out", "--keep-going", "--stats", "--json",
+                                       "--workers", "1", "--engine", "numpy"])
+    assert result.exit_code == 2
+    assert result.stderr == "error: ./bad.yaml:5:35: objects[0].sphere.radius: must be > 0, got -1\n"
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["blue.png", "green.png", "red.png"]
+    lines = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [d["scene"] for d in lines] == ["./blue.yaml", "./green.yaml", "./red.yaml"]
+    assert run("render", "red.yaml", "-o", "alone.png", "--engine", "numpy").exit_code == 0
+    assert (tmp_path / "alone.png").read_bytes() == (tmp_path / "out" / "red.png").read_bytes()
+
+
+def test_without_keep_going_a_broken_scene_in_a_folder_writes_nothing(run, tmp_path):
+    (tmp_path / "bad.yaml").write_text(BAD)
+    result = run("render", ".", "-o", "out")
+    assert result.exit_code == 2
+    assert result.output == "error: ./bad.yaml:5:35: objects[0].sphere.radius: must be > 0, got -1\n"
+    assert not (tmp_path / "out").exists()
+
+
+def test_keep_going_reports_every_broken_scene_and_keeps_the_folder(run, tmp_path):
+    """Scenes broken in loading (a missing file, bad YAML) and in rendering (a size too big) each get
+    their line, in order; the folder is made even when no scene renders, for `compare` to list them."""
+    (tmp_path / "bad.yaml").write_text(BAD)
+    result = run("render", "bad.yaml", "missing.yaml", "red.yaml", "-o", "out", "--keep-going")
+    assert result.exit_code == 2
+    assert result.output.splitlines() == ["error: bad.yaml:5:35: objects[0].sphere.radius: must be > 0, got -1",
+                                          "error: missing.yaml: file not found: missing.yaml"]
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["red.png"]
+    result = run("render", "bad.yaml", "missing.yaml", "-o", "none", "--keep-going")
+    assert result.exit_code == 2 and result.output.count("\n") == 2
+    assert (tmp_path / "none").is_dir() and not list((tmp_path / "none").iterdir())
+    result = run("render", "red.yaml", "green.yaml", "-o", "wide", "--keep-going", "--width", "20000")
+    assert result.exit_code == 2
+    assert [line[:30] for line in result.output.splitlines()] == ["error: red.yaml: 20000x15000 i",
+                                                                  "error: green.yaml: 20000x15000"]
+    assert not list((tmp_path / "wide").iterdir())
+
+
+def test_keep_going_still_refuses_an_output_that_is_an_input(run, tmp_path):
+    """Errors about the outputs are not a broken scene's: the run stops and nothing is written."""
+    from PIL import Image
+    (tmp_path / "out").mkdir()
+    Image.new("RGB", (2, 2), (0, 255, 0)).save(tmp_path / "out" / "red.png")
+    texture = (tmp_path / "out" / "red.png").read_bytes()
+    (tmp_path / "tex.yaml").write_text(SCENE.replace("reflection: 0.2", "texture: {image: out/red.png}") % "1, 1, 1")
+    result = run("render", "red.yaml", "tex.yaml", "-o", "out", "--keep-going")
+    assert result.exit_code == 2
+    assert result.output == "error: out/red.png: is an input of this run; it will not be overwritten (choose " \
+                            "another output name)\n"
+    assert (tmp_path / "out" / "red.png").read_bytes() == texture
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["red.png"]
+
+
+def test_keep_going_takes_no_watch_or_frames(run):
+    for extra in (["--watch"], ["--frames", "1-2"], ["-o", "f_%04d.png"]):
+        result = run("render", "red.yaml", "--keep-going", *extra)
+        assert result.exit_code == 2
+        assert result.output.startswith("error: --keep-going renders the other scenes when one is broken")
+
+
 @pytest.mark.parametrize("args, message", [
     (["red.yaml", "green.yaml", "-o", "x.png"], "x.png: with several scenes, -o names a folder for their images"),
     (["red.yaml", "sub/red.yaml"], "red.yaml and sub/red.yaml would both render to red.png"),

@@ -4,6 +4,11 @@ One LocalCluster of two worker processes (one thread each) serves the module; it
 scene uses an include, a mesh and a texture, so the workers build it from the bytes
 the client read. The errors (no Dask, no scheduler, other software on a worker, a
 lost cluster) are checked by their one line.
+
+A worker that compiles the engine, and `rtcli warmup --cluster`, are checked on a
+LocalCluster whose workers are threads of this process (`threads`), where the engine's
+start-up is replaced by one that compiles for show: a real compile takes minutes. One
+test compiles a small part of it for real, on a worker process with a cache of its own.
 """
 
 from __future__ import annotations
@@ -11,8 +16,11 @@ from __future__ import annotations
 import json
 import logging
 import os
+import re
 import signal
 import sys
+import threading
+from collections import OrderedDict
 
 import numpy as np
 import pytest
@@ -20,8 +28,9 @@ from click.testing import CliRunner
 from PIL import Image
 
 from rtcli import cluster as dask_cluster
-from rtcli import frames
+from rtcli import frames, runs, variants
 from rtcli.cli import main
+from rtcli.compiled.loading import Load
 from rtcli.errors import RtcliError
 from rtcli.render import Job, render
 
@@ -49,6 +58,16 @@ MESH = "v -1 0 -1\nv 1 0 -1\nv 0 1.5 -1\nv 0 0 0\nf 1 2 3\nf 1 4 3\n"
 def cluster():
     c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                  dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
+    yield c
+    c.close()
+
+
+@pytest.fixture(scope="module")
+def threads():
+    """Two workers in threads of this process (on loopback TCP, as a real cluster): what the tests
+    replace in rtcli's modules, the workers run."""
+    c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, protocol="tcp",
+                                 host="127.0.0.1", dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
     yield c
     c.close()
 
@@ -182,10 +201,22 @@ def test_cluster_errors_are_one_line(run, tmp_path, args, message):
     assert not (tmp_path / "c.png").exists()
 
 
-@pytest.mark.parametrize("command", ["render", "signature"])
+def test_warmup_takes_the_cluster_options_as_render_does(run):
+    import dask
+    with dask.config.set({"distributed.comm.timeouts.connect": "0.5s"}):
+        for args, message in [(["--cluster", "tcp://127.0.0.1:1"], "cannot reach the Dask scheduler at "
+                                                                   "tcp://127.0.0.1:1: Timed out"),
+                              (["--cluster-file", "nowhere.json"], "--cluster-file nowhere.json: file not found")]:
+            result = run("warmup", *args)
+            assert result.exit_code == 2 and result.output.startswith(f"error: {message}"), result.output
+            assert result.output.count("\n") == 1
+
+
+@pytest.mark.parametrize("command", [["render", "scene.yaml", "-o", "c.png"], ["signature", "scene.yaml", "-o", "c.png"],
+                                     ["warmup"]])
 def test_without_dask_the_error_names_the_extra(run, tmp_path, monkeypatch, command):
     monkeypatch.setitem(sys.modules, "distributed", None)                 # import distributed fails
-    result = run(command, "scene.yaml", "-o", "c.png", "--local-cluster", "2")
+    result = run(*command, "--local-cluster", "2")
     assert (result.exit_code, result.output) == (2, "error: a cluster needs Dask's distributed scheduler, which is "
                                                     "not installed: pip install -e '.[cluster]' in the rtcli folder "
                                                     "(rtcli is not on the package index)\n")
@@ -266,3 +297,175 @@ def test_several_scenes_on_the_cluster_are_the_local_renders_all_placed_or_none(
     assert (result.exit_code, result.output) == (2, "error: bad.yaml:12:44: objects[2].sphere.radius: must be > 0, "
                                                     "got -1\n")
     assert not (tmp_path / "none").exists()
+
+
+# --- the engine's start-up on the workers ---
+COMPILING = "compiling the render engine, once (about a minute); cached in /somewhere"
+
+
+@pytest.fixture
+def compiling(monkeypatch):
+    """The engine's start-up on the `threads` workers (whose tasks give notes) replaced by one that says it compiles, waits
+    until `heard` is set (at most 60 s; whether it was, in `waited`), and reports 2.5 s of compiling."""
+    rendering = sys.modules["rtcli.render"]              # the module (rtcli.render is also rtcli's function)
+    real, heard, waited = rendering.prepare, threading.Event(), []
+
+    def prepare(scene, job, traced, notes=None):
+        if notes is None:                                # a render here, not on a worker
+            return real(scene, job, traced)
+        notes(COMPILING)
+        waited.append(heard.wait(60))
+        engine, load = real(scene, job, traced, notes)
+        return engine, (load or Load()) + Load(2.5, 2.5)
+    monkeypatch.setattr(rendering, "prepare", prepare)
+    monkeypatch.setattr(dask_cluster, "_scenes", OrderedDict())       # no scene kept from another test
+    return heard, waited
+
+
+def test_the_client_hears_a_worker_compile_while_the_render_runs(run, threads, compiling):
+    """The note reaches the client while the worker still compiles (its task waits for it); after
+    the render, a note for the worker that compiled, with its time. (The `threads` workers share
+    this process's kept scenes: the first to prepare the engine prepares it for both.)"""
+    heard, waited = compiling
+    notes = []
+
+    def note(text):
+        notes.append(text)
+        if text.endswith(COMPILING):
+            heard.set()
+    loaded = frames.load("scene.yaml", frame=2, keep=True)
+    with frames.Reach(dask_cluster.Target(threads.scheduler_address), note) as where:
+        image, _ = frames.render_image(loaded, Job(36, 24, tile=8), 1, None, where)
+    assert image.tobytes() == render(loaded.scene, Job(36, 24))[0].tobytes()
+    assert waited == [True]                             # heard while the worker was still compiling
+    worker = notes[0].split()[1].rstrip(":")
+    assert worker in threads.scheduler_info["workers"]
+    assert notes == [f"worker {worker}: {COMPILING}",
+                     f"worker {worker} compiled the engine in 2.5 s (cached there for later renders)"]
+
+
+def test_render_prints_the_workers_notes_before_the_bar_ends(run, threads, compiling):
+    heard, _ = compiling
+    heard.set()                                          # the worker need not wait: the order is checked
+    result = run("render", "scene.yaml", "--frame", "3", "--tile", "8", "-o", "c.png", "--progress",
+                 "--cluster", threads.scheduler_address)
+    assert result.exit_code == 0, result.output
+    err = result.stderr
+    first = err.index(f": {COMPILING}\n")
+    assert err[:first].startswith("note: worker tcp://127.0.0.1:") and "\n" not in err[:first]
+    assert first < err.index("100%")
+    assert err.rstrip("\n").splitlines()[-1].endswith(" compiled the engine in 2.5 s (cached there for later renders)")
+
+
+def test_frames_on_a_cluster_tell_it_too(run, threads, compiling):
+    """A frame a task: each frame's engine start-up (here, each compiles for show) is told, and the
+    summary adds up each worker's seconds."""
+    heard, _ = compiling
+    heard.set()
+    result = run("render", "scene.yaml", "--frames", "1-2", "-o", "f_%d.png", "--cluster", threads.scheduler_address)
+    assert result.exit_code == 0, result.output
+    lines = result.stderr.splitlines()
+    assert [line.endswith(f": {COMPILING}") for line in lines[:2]] == [True, True]        # a note each frame
+    summary = [re.fullmatch(r"note: worker tcp://127\.0\.0\.1:\d+ compiled the engine in ([\d.]+) s "
+                            r"\(cached there for later renders\)", line) for line in lines[2:]]
+    assert summary and all(summary) and sum(float(m[1]) for m in summary) == 5.0
+
+
+def test_a_note_ends_the_progress_bar_line_it_comes_under(capsys):
+    show = runs.progress_bar(True, "s")
+    show(1, 2)
+    runs.note("a worker speaks")
+    show(2, 2)
+    runs.note("done")
+    bar = "\rs [" + "#" * 15 + " " * 15 + "]  50%"
+    assert capsys.readouterr().err == (f"{bar}\nnote: a worker speaks\n\rs [{'#' * 30}] 100%\nnote: done\n")
+
+
+def fake_warmup(compiles: set, fails: set):
+    """rtcli.compiled.warmup.warmup for the `threads` workers: a worker whose address is in `compiles`
+    compiles the render engine for show (3.5 s, with its note); one in `fails` cannot load numba."""
+    def warmup(notes=None):
+        address = notes.worker.address
+        if address in fails:
+            raise RtcliError("numba cannot be loaded (no module named numba)")
+        if address in compiles:
+            notes(COMPILING)
+            notes("compiled in 3.5 s")
+        seconds = 3.5 if address in compiles else 0.0
+        return [("the render engine (compiled)", Load(seconds + 0.25, seconds)),
+                ("the numpy engine's BVH walks", Load(0.25))], (["trace_camera", "levels"], None)
+    return warmup
+
+
+def test_warmup_on_a_cluster_reports_each_worker(run, threads, monkeypatch):
+    from rtcli.compiled import warmup
+    first, second = sorted(threads.scheduler_info["workers"])
+    monkeypatch.setattr(warmup, "warmup", fake_warmup({second}, set()))
+    result = run("warmup", "--cluster", threads.scheduler_address)
+    assert result.exit_code == 0, result.output
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith(f"{first}: already warm (loaded in ") and lines[0].endswith(" s)")
+    assert lines[1].startswith(f"{second}: compiled in 3.5 s (the render engine (compiled) 3.5 s), ready in ")
+    assert lines[2:] == ["2 workers warm, 1 of them compiled"]
+    assert result.stderr == f"note: worker {second}: {COMPILING}\nnote: worker {second}: compiled in 3.5 s\n"
+
+
+def test_a_worker_that_cannot_be_warmed_is_one_line_and_exit_2(run, threads, monkeypatch):
+    from rtcli.compiled import warmup
+    first, second = sorted(threads.scheduler_info["workers"])
+    monkeypatch.setattr(warmup, "warmup", fake_warmup(set(), {first}))
+    result = run("warmup", "--cluster", threads.scheduler_address)
+    assert result.exit_code == 2
+    assert result.stdout.startswith(f"{second}: already warm") and result.stdout.count("\n") == 1
+    assert result.stderr == (f"error: 1 of 2 workers could not be warmed: {first}: numba cannot be loaded "
+                             "(no module named numba)\n")
+
+
+@pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
+def test_warmup_on_local_worker_processes_reports_each(run):
+    """The real warmup on two worker processes sharing this machine's cache: each reports (already
+    warm when `make warmup` ran, else compiled)."""
+    result = run("warmup", "--local-cluster", "2")
+    assert result.exit_code == 0, result.output
+    lines = result.stdout.splitlines()
+    assert len(lines) == 3 and lines[2].startswith("2 workers warm, ")
+    for line in lines[:2]:
+        assert line.startswith("tcp://127.0.0.1:") and (": already warm (loaded in " in line or ": compiled in " in line)
+
+
+def test_warmup_refuses_a_worker_with_other_software(run, cluster, monkeypatch):
+    monkeypatch.setattr(dask_cluster, "_fingerprint", dict(dask_cluster.fingerprint(), numpy="0.0"))
+    result = run("warmup", "--cluster", cluster.scheduler_address)
+    assert result.exit_code == 2 and result.output.count("\n") == 1
+    assert result.output.startswith("error: the worker tcp://127.0.0.1:")
+    assert f"runs other software (numpy 0.0 here, {np.__version__} there)" in result.output
+
+
+@pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
+def test_a_cold_worker_process_compiles_and_says_so(run, tmp_path):
+    """A worker process with a cache of its own that lacks the BVH walks (they compile in seconds
+    when what they call is cached; the integrator takes minutes): warmup compiles them there, for
+    real, and the client hears it."""
+    from test_startup import WALKS, seeded
+
+    from rtcli.compiled.warmup import warmup
+    if variants.cache_location().root is not None:
+        pytest.skip("the cache is not beside the sources here (RTCLI_CACHE_DIR or NUMBA_CACHE_DIR is set)")
+    warmup(notes=lambda text: None)                     # the cache to seed from, warm
+    cache = seeded(tmp_path / "cache", WALKS)
+    env = {variants.CACHE_ENV: str(cache), "RTCLI_MACHINE_CODE": "0"}
+    cold = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                    dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL, env=env)
+    try:
+        result = run("warmup", "--cluster", cold.scheduler_address)
+        again = run("warmup", "--cluster", cold.scheduler_address)
+    finally:
+        cold.close()
+    assert result.exit_code == 0, result.output
+    worker = result.stdout.split(": ")[0]
+    assert result.stderr.splitlines() == [
+        f"note: worker {worker}: compiling the numpy engine's BVH walks, once (about half a minute); cached in {cache}",
+        result.stderr.splitlines()[1]]
+    assert result.stderr.splitlines()[1].startswith(f"note: worker {worker}: compiled in ")
+    assert result.stdout.startswith(f"{worker}: compiled in ") and "the numpy engine's BVH walks" in result.stdout
+    assert again.exit_code == 0 and again.stdout.startswith(f"{worker}: already warm") and again.stderr == ""

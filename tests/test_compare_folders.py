@@ -77,7 +77,14 @@ def test_all_pairs_passing_exits_0(folders):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["actual", "expected/same.png"], "actual is a folder: compare two folders or two images"),
+    (["actual", "expected/same.png"], "actual is a folder but expected/same.png is not: compare two folders or "
+                                      "two images"),
+    (["expected/same.png", "actual"], "actual is a folder but expected/same.png is not"),
+    (["actual", "golden"], "golden: no such folder (to compare with the folder actual)"),
+    (["golden", "expected", "--report", "r", "--junit", "j.xml"], "golden: no such folder (to compare with the "
+                                                                  "folder expected)"),
+    (["renders", "golden", "--report", "r"], "renders: no such file or folder"),
+    (["actual/same.png", "gone.png"], "gone.png: no such file"),
     (["actual", "expected", "--diff", "d.png"], "--diff, --flip and --ids compare two images"),
     (["actual/same.png", "expected/same.png", "--junit", "j.xml"], "--report and --junit compare two folders"),
     (["actual", "expected", "--report", "actual/r"], "actual/r: the report folder must be outside the compared"),
@@ -100,12 +107,14 @@ def test_junit_file_follows_the_schema_and_reads_as_test_results(folders):
     assert run("compare", "actual", "expected", "--junit", "results.xml").exit_code == 1
     xmlschema.XMLSchema(str(SCHEMA)).validate("results.xml")
     suite = next(iter(junitparser.JUnitXml.fromfile("results.xml")))
-    assert (suite.tests, suite.failures, suite.errors) == (7, 3, 1)
+    assert (suite.tests, suite.failures, suite.errors) == (7, 2, 2)
     outcome = {case.name: [type(r).__name__ for r in case.result] for case in suite}
-    assert outcome == {"broken.png": ["Error"], "changed.png": ["Failure"], "gone.png": ["Failure"],
+    assert outcome == {"broken.png": ["Error"], "changed.png": ["Failure"], "gone.png": ["Error"],
                        "new.png": ["Failure"], "s.ids.png": [], "same.png": [], "sub/deep.png": []}
     failure = next(case for case in suite if case.name == "changed.png").result[0]
     assert failure.message.startswith("FAIL: 64 bad pixels (limit 16)")
+    missing = next(case for case in suite if case.name == "gone.png").result[0]
+    assert (missing.type, missing.message) == ("missing", "MISSING: no actual image for expected/gone.png")
 
 
 def test_report_replaces_an_earlier_report_only(folders):
@@ -121,11 +130,22 @@ def test_report_replaces_an_earlier_report_only(folders):
 def test_report_rows_are_worst_first_with_their_pictures(folders):
     run("compare", "actual", "expected", "--report", "report")
     html = (folders / "report" / "index.html").read_text()
-    statuses = re.findall(r'<tr class="pair (\w+)"', html)
-    assert statuses == ["unreadable", "missing", "extra", "failing", "ok", "ok", "ok"]
+    rows = re.findall(r'<tr class="pair ([\w ]+)"', html)
+    assert rows == ["unreadable error", "missing error", "extra failure", "failing failure", "ok", "ok", "ok"]
     for name in re.findall(r'<img src="([^"]+)"', html):
         assert (folders / "report" / name).is_file()
     assert html.count('-difference.png"') == 2 * 4                 # link and picture of the 4 comparable pairs
+
+
+def test_a_golden_without_a_render_is_an_error_row_showing_the_golden(folders):
+    run("compare", "actual", "expected", "--report", "report")
+    html = (folders / "report" / "index.html").read_text()
+    row = re.search(r'<tr class="pair missing error".*?</tr>', html).group(0)
+    assert '<span class="result">error</span>' in row and "MISSING: no actual image for expected/gone.png" in row
+    pictures = re.findall(r'<img src="([^"]+)" alt="(\w+) of gone.png"', row)
+    assert [column for _, column in pictures] == ["expected"]
+    shown = np.asarray(Image.open(folders / "report" / pictures[0][0]))
+    assert np.array_equal(shown, np.asarray(Image.open(folders / "expected" / "gone.png")))
 
 
 @pytest.mark.skipif(not os.path.exists(CHROMIUM), reason="needs Debian's chromium (.ci/run installs it)")
@@ -135,7 +155,7 @@ def test_report_shows_every_row_and_picture_in_a_browser(folders, tmp_path):
     pictures = html.count("<img ")
     dom = chromium("--virtual-time-budget=10000", "--dump-dom", (folders / "report" / "index.html").as_uri(),
                    profile=tmp_path / "profile")
-    assert len(re.findall(r'<tr class="pair \w+" id="pair-\d+">', dom)) == 7
+    assert len(re.findall(r'<tr class="pair [\w ]+" id="pair-\d+">', dom)) == 7
     assert f'data-images-loaded="{pictures}"' in dom and 'class="broken"' not in dom
     shutil.rmtree(folders / "report" / "images")
     dom = chromium("--virtual-time-budget=10000", "--dump-dom", (folders / "report" / "index.html").as_uri(),

@@ -18,6 +18,7 @@ from rtcli import variants
 from rtcli.errors import RtcliError
 from rtcli.render import Job, render, render_tile
 from rtcli.scenefile.build import load_scene
+from helpers import without_avx512
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 
@@ -92,27 +93,15 @@ def test_every_supported_scene_renders_the_same_pixels_and_rays(path):
     assert (sa.engine, sb.engine) == ("numpy", "compiled")
 
 
-def _svml() -> bool:
-    """numpy computes x ** y with Intel's SVML (within 1 ulp of libm's pow) on AVX512_SKX CPUs."""
-    try:
-        from numpy._core._multiarray_umath import __cpu_features__
-    except ImportError:
-        return True
-    return bool(__cpu_features__.get("AVX512_SKX", True))
-
-
 def test_colors_are_equal_to_the_last_bit(yaml_scene):
-    """Before rounding to bytes: every sum and product is taken in the numpy core's order. Where
-    numpy's pow is SVML's rather than libm's (AVX512 CPUs) the specular term may differ by an ulp."""
+    """Before rounding to bytes: every sum and product is taken in the numpy core's order, and every
+    elementary function is rtcli's own (rtcli/core/elementary.py)."""
     scene = load_scene(str(ROOT / "bench" / "quadrics.yaml"))
     i, j = np.meshgrid(np.arange(0, 640, 7), np.arange(0, 480, 5))
     job = Job(640, 480)
     a, _ = render_tile(scene, job, i.ravel(), j.ravel())
     b, _ = render_tile(scene, job, i.ravel(), j.ravel(), fast.choose(scene, "compiled"))
-    if _svml():
-        np.testing.assert_allclose(a, b, rtol=1e-13, atol=0)
-    else:
-        assert np.array_equal(a, b)
+    assert np.array_equal(a, b)
 
 
 TRANSFORMED = """
@@ -455,8 +444,7 @@ def random_csg_scene(seed: int, solids) -> str:
 def test_random_csg_trees_render_the_same_in_both_engines(yaml_scene, seed, torus):
     """Random trees of every solid (nested, children transformed and with materials of their own,
     glass inside glass, filtering shadows): the same bytes and the same rays in both engines. The
-    torus's roots may differ by ulps where numpy takes arccos and cbrt from SVML (rtcli/variants.py),
-    which can tip a ray here and there: then the rays may differ by a few in a thousand."""
+    torus's roots included."""
     scene = yaml_scene(random_csg_scene(seed, SOLIDS if torus else tuple(k for k in SOLIDS if k != "torus")))
     ids, _ = render(scene, Job(80, 60, signature=True))
     assert np.count_nonzero(ids == 2) > 100 and np.count_nonzero(ids == 3) > 100, "both csgs must be in view"
@@ -464,10 +452,30 @@ def test_random_csg_trees_render_the_same_in_both_engines(yaml_scene, seed, toru
     assert np.array_equal(a, b), f"{np.count_nonzero((a != b).any(axis=2))} pixels differ"
     rays_a = np.array([sa.shadow, sa.reflected, sa.refracted])
     rays_b = np.array([sb.shadow, sb.reflected, sb.refracted])
-    if torus and _svml():
-        assert np.all(np.abs(rays_a - rays_b) <= 2e-3 * rays_a)
-    else:
-        assert np.array_equal(rays_a, rays_b)
+    assert np.array_equal(rays_a, rays_b)
+
+
+CPU_SENSITIVE = ["textures", "torus", "spot", "phong", "csg", "aquarium", "presets"]
+
+
+def test_numpys_two_code_paths_and_both_engines_give_the_same_bytes(tmp_path):
+    """Scenes whose pixels take powers (specular, spot cones, --gamma), arc sines and arc tangents
+    (uv), cube roots (the torus) and rotations, and a random CSG tree with a torus: rendered by the
+    numpy engine in a process whose numpy has no AVX-512 paths (SVML), and here by both engines."""
+    (tmp_path / "random.yaml").write_text(random_csg_scene(11, SOLIDS))
+    paths = [str(ROOT / "scenes" / f"{name}.yaml") for name in CPU_SENSITIVE] + [str(tmp_path / "random.yaml")]
+    code = ("import sys, numpy as np; from rtcli.render import Job, render; from rtcli.scenefile.build import "
+            "load_scene; from rtcli.writer import to_8bit; "
+            "[np.save(f'{sys.argv[1]}/{k}.npy', to_8bit(render(load_scene(p), Job(80, 60, engine='numpy'))[0], "
+            "gamma=True)) for k, p in enumerate(sys.argv[2:])]")
+    without_avx512(["-c", code, str(tmp_path), *paths])
+    from rtcli.writer import to_8bit
+    for k, path in enumerate(paths):
+        other = np.load(tmp_path / f"{k}.npy")
+        for engine in ("numpy", "compiled"):
+            image = to_8bit(render(load_scene(path), Job(80, 60, engine=engine))[0], gamma=True)
+            differ = np.count_nonzero((image != other).any(axis=2))
+            assert differ == 0, f"{Path(path).stem}, {engine} engine: {differ} pixels differ from numpy without AVX-512"
 
 
 COINCIDENT = """

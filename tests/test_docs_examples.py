@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 import os
 import re
 import subprocess
@@ -16,6 +17,7 @@ from pathlib import Path
 
 import junitparser
 import pytest
+import xmlschema
 
 ROOT = Path(__file__).resolve().parent.parent
 BLOCK = re.compile(r"^```(\w+)\n(.*?)^```$", re.M | re.S)
@@ -56,7 +58,8 @@ objects: [{name: ball, sphere: {radius: 1}, material: {diffuse: [%s]}}]
 
 
 def test_the_ci_example_passes_then_catches_a_change(tmp_path):
-    """docs/ci.md: make the goldens, run ci/golden.sh (exit 0), change a scene, run it again (exit 1)."""
+    """docs/ci.md: make the goldens, run ci/golden.sh (exit 0), change a scene, run it again (exit 1),
+    break a scene: exit 2, and the other scene is still rendered, compared and reported."""
     make_goldens, script = [code for kind, code in blocks("ci.md") if kind == "sh"]
     (tmp_path / "scenes").mkdir()
     (tmp_path / "scenes" / "red.yaml").write_text(SCENE % "1, 0, 0")
@@ -75,10 +78,27 @@ def test_the_ci_example_passes_then_catches_a_change(tmp_path):
     failed = sh("sh ci/golden.sh")
     assert failed.returncode == 1
     assert "blue.png: FAIL" in failed.stdout
-    assert '<tr class="pair failing"' in (tmp_path / "report" / "index.html").read_text()
+    assert '<tr class="pair failing failure"' in (tmp_path / "report" / "index.html").read_text()
     suite = next(iter(junitparser.JUnitXml.fromfile(str(tmp_path / "junit.xml"))))
     assert (suite.tests, suite.failures) == (2, 1)
     assert len((tmp_path / "renders.jsonl").read_text().splitlines()) == 2
+    (tmp_path / "scenes" / "blue.yaml").write_text(SCENE.replace("radius: 1", "raduis: 1") % "0, 0, 1")
+    broken = sh("sh ci/golden.sh")
+    assert broken.returncode == 2
+    assert broken.stderr == ("error: scenes/blue.yaml:4:33: objects[0].sphere.raduis: unknown key (did you mean "
+                             "'radius'?); allowed here: center, radius\n")
+    assert broken.stdout.splitlines() == [
+        "blue.png: MISSING: no actual image for golden/blue.png", "red.png: " + passed.stdout.splitlines()[1][9:],
+        "FAIL: 2 pairs: 1 ok, 0 failing, 1 missing, 0 extra, 0 unreadable"]
+    assert [json.loads(line)["scene"] for line in (tmp_path / "renders.jsonl").read_text().splitlines()] == [
+        "scenes/red.yaml"]
+    html = (tmp_path / "report" / "index.html").read_text()
+    assert '<tr class="pair missing error"' in html and '<tr class="pair ok"' in html
+    xmlschema.XMLSchema(str(ROOT / "tests" / "data" / "JUnit.xsd")).validate(str(tmp_path / "junit.xml"))
+    suite = next(iter(junitparser.JUnitXml.fromfile(str(tmp_path / "junit.xml"))))
+    assert (suite.tests, suite.failures, suite.errors) == (2, 0, 1)
+    assert {case.name: [type(r).__name__ for r in case.result] for case in suite} == {"blue.png": ["Error"],
+                                                                                      "red.png": []}
 
 
 def test_the_debugging_guide_shows_what_explain_prints(monkeypatch):

@@ -141,3 +141,24 @@ def test_render_view_writes_the_picture_and_prints_what_it_shows(tmp_path, monke
     assert np.array_equal(np.asarray(Image.open("b.png")), rtcli.view(MIRRORS, "bounces").picture)
     result = CliRunner().invoke(main, ["render", "mirrors.yaml", "--view", "normal", "--stats"])
     assert result.exit_code == 2 and "--stats counts the rays of a render, not of a --view" in result.output
+
+
+def test_render_view_ids_writes_the_id_map_that_compare_ids_reads(tmp_path, monkeypatch):
+    """`render --view ids` writes NAME.ids.png as `signature --ids` does (golden_images/NAME.ids.png's
+    format), so `compare --ids` and a folder comparison read it as an id map."""
+    from click.testing import CliRunner
+
+    from rtcli.cli import main
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.yaml").write_text(SCENE)
+    result = CliRunner().invoke(main, ["render", "s.yaml", "--view", "ids"])
+    assert result.exit_code == 0, result.output
+    assert result.output == "ids: the signature's ids, 0 (background) to 2, as a 16-bit id map (rtcli signature " \
+                            "draws them in colors)\n"
+    assert CliRunner().invoke(main, ["signature", "s.yaml", "--ids", "sig.ids.png", "--workers", "1"]).exit_code == 0
+    assert (tmp_path / "s.ids.png").read_bytes() == (tmp_path / "sig.ids.png").read_bytes()
+    assert Image.open(tmp_path / "s.ids.png").mode == "I;16"
+    result = CliRunner().invoke(main, ["compare", "s.ids.png", "sig.ids.png", "--ids"])
+    assert result.exit_code == 0 and result.output.startswith("OK: 0 mismatched ids"), result.output
+    result = CliRunner().invoke(main, ["render", "s.yaml", "--view", "ids", "-o", "s.jpg"])
+    assert result.exit_code == 2 and not (tmp_path / "s.jpg").exists()

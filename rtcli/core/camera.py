@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.core.vec import cross3, unit3
+from rtcli.core.elementary import cos, sin
+from rtcli.core.vec import cross3, length3, unit3
 from rtcli.variants import kernel
 
 EYE, ORIGIN, RIGHT, DOWN = 0, 3, 6, 9     # offsets of the vectors in Camera.row
@@ -32,11 +33,11 @@ def primary_ray(cam, x, y, nc, nr):
 def eye_basis(eye, look_at, up) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(u, v, w): w toward look_at, u = w x up to the right, v = u x w up. ValueError if degenerate."""
     w = np.asarray(look_at, float) - np.asarray(eye, float)
-    if np.linalg.norm(w) == 0:
+    if length3(w) == 0:
         raise ValueError("look_at must differ from eye")
     w = unit3(w)
     side = cross3(w, np.asarray(up, float))
-    if np.linalg.norm(side) <= 1e-9 * np.linalg.norm(up):
+    if length3(side) <= 1e-9 * length3(up):
         raise ValueError("up must not be parallel to the view direction")
     u = unit3(side)
     return u, cross3(u, w), w
@@ -59,7 +60,8 @@ class Camera:
 def from_fov(eye, look_at, up, fov: float, nc: int, nr: int) -> Camera:
     """Vertical field of view `fov` in degrees; the width follows the image's aspect."""
     u, v, w = eye_basis(eye, look_at, up)
-    half_h = np.tan(np.radians(fov) / 2)
+    angle = np.radians(fov) / 2
+    half_h = float(sin(angle) / cos(angle))                     # tan(fov / 2)
     half_w = half_h * nc / nr
     corner = np.asarray(eye, float) + w - half_w * u + half_h * v
     return Camera(np.asarray(eye, float), corner, 2 * half_w * u, -2 * half_h * v)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rtcli.core.elementary import power
 from rtcli.core.jitter import hash_point
 from rtcli.core.vec import dot
 from rtcli.variants import kernel, maximum, select, sqrt
@@ -84,7 +85,7 @@ def spot_factor(light, Lx, Ly, Lz):
     if light[IS_SPOT] == 0:
         return 1.0
     cos = -dot(Lx, Ly, Lz, light[SPOT_AXIS], light[SPOT_AXIS + 1], light[SPOT_AXIS + 2])
-    return select(cos >= light[SPOT_COS], maximum(cos, 0.0) ** light[SPOT_FALLOFF], 0.0)
+    return select(cos >= light[SPOT_COS], power(maximum(cos, 0.0), light[SPOT_FALLOFF]), 0.0)
 
 
 @kernel

@@ -15,6 +15,7 @@ import numpy as np
 from rtcli.core.bvh import BVH, PAD
 from rtcli.core.materials import MaterialTable
 from rtcli.core.transform import Transform, outer_bounds
+from rtcli.core.vec import length3
 
 BVH_MIN_OBJECTS = 8        # from this many bounded objects on, a BVH over them pays (both engines)
 
@@ -115,7 +116,7 @@ class Scene:
         b = self.boxes
         lo = np.min(np.vstack([self.eye, b.lo[b.bounded]]), axis=0)
         hi = np.max(np.vstack([self.eye, b.hi[b.bounded]]), axis=0)
-        return max(float(np.linalg.norm(hi - lo)), 1e-3)
+        return max(float(length3(hi - lo)), 1e-3)
 
     @property
     def offset(self) -> float:

@@ -12,6 +12,7 @@ its arrays), `m` the material of each hit.
 
 from __future__ import annotations
 
+from rtcli.core.elementary import power
 from rtcli.core.vec import dot
 from rtcli.variants import kernel, maximum, select, sqrt
 
@@ -44,7 +45,7 @@ def specular_cos(blinn, Nx, Ny, Nz, Lx, Ly, Lz, Vx, Vy, Vz, NL, NV):
 @kernel(inline=True)
 def specular(mats, m, I, w, cos):
     """w max(0, cos)^n I ks: the specular term of one light point."""
-    ws = w * maximum(cos, 0.0) ** mats.shininess[m]
+    ws = w * power(maximum(cos, 0.0), mats.shininess[m])
     return ws * I[0] * mats.ks[m, 0], ws * I[1] * mats.ks[m, 1], ws * I[2] * mats.ks[m, 2]
 
 

@@ -5,7 +5,10 @@ For the kernels it is packed as three 3x4 matrices in a row of 36 floats
 (`Transform.packed`): world_from_object (WORLD), object_from_world (OBJECT), and the
 inverse transpose A^-T that takes object-space normals to world space (NORMAL, its
 4th column 0). Products are written out per component, so a row's result never
-depends on how many rows share the batch.
+depends on how many rows share the batch; so are the matrices' products and inverses
+(no BLAS or LAPACK, whose order of operations depends on the CPU), and rotations take
+their sine and cosine from rtcli/core/elementary.py: a scene's transforms have the same
+bits on every CPU.
 """
 
 from __future__ import annotations
@@ -14,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.core.vec import split, stack
+from rtcli.core.elementary import cos, sin
+from rtcli.core.vec import cross3, dot3, length3, split, stack
 from rtcli.variants import kernel
 
 WORLD, OBJECT, NORMAL, PACKED = 0, 12, 24, 36        # offsets of the 3x4 matrices in Transform.packed
@@ -59,11 +63,12 @@ class Transform:
     def from_matrix(m: np.ndarray) -> "Transform":
         """Raises ValueError for a singular matrix."""
         m = np.asarray(m, dtype=float)
-        det = np.linalg.det(m[:3, :3])
+        a, b, c = m[:3, :3]
+        det = float(dot3(a, cross3(b, c)))
         scale = max(np.abs(m[:3, :3]).max(), 1e-300) ** 3
         if not np.isfinite(det) or abs(det) <= 1e-12 * scale:
             raise ValueError("singular transform (determinant 0)")
-        return Transform(m, np.linalg.inv(m))
+        return Transform(m, affine_inverse(m))
 
     @staticmethod
     def identity() -> "Transform":
@@ -71,7 +76,7 @@ class Transform:
 
     def then(self, other: "Transform") -> "Transform":
         """This transform followed by `other` (the YAML list order)."""
-        return Transform(other.m @ self.m, self.m_inv @ other.m_inv)
+        return Transform(product(other.m, self.m), product(self.m_inv, other.m_inv))
 
     @property
     def inverse(self) -> "Transform":
@@ -95,6 +100,29 @@ class Transform:
         return stack(*normal_to_world(self.packed, 0, *split(n)))
 
 
+def product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The 4x4 matrix product a b, each entry summed over k = 0..3 in that order."""
+    return sum(a[:, k:k + 1] * b[k:k + 1, :] for k in range(4))
+
+
+def affine_inverse(m: np.ndarray) -> np.ndarray:
+    """The inverse of [A t; 0 1]: [A^-1, -A^-1 t], A^-1 by Gauss-Jordan elimination with partial
+    pivoting on [A | I], one row operation at a time (a scale's inverse is 1/s, rounded once)."""
+    rows = np.hstack([m[:3, :3], np.eye(3)])
+    for k in range(3):
+        pivot = k + int(np.argmax(np.abs(rows[k:, k])))
+        rows[[k, pivot]] = rows[[pivot, k]]
+        rows[k] = rows[k] / rows[k, k]
+        for i in range(3):
+            if i != k:
+                rows[i] = rows[i] - rows[i, k] * rows[k]
+    inverse = np.eye(4)
+    inverse[:3, :3] = rows[:, 3:]
+    t = m[:3, 3]
+    inverse[:3, 3] = -(inverse[:3, 0] * t[0] + inverse[:3, 1] * t[1] + inverse[:3, 2] * t[2])
+    return inverse
+
+
 def translate(t) -> Transform:
     m = np.eye(4)
     m[:3, 3] = t
@@ -108,17 +136,18 @@ def scale(s) -> Transform:
 def rotate(axis, degrees: float) -> Transform:
     """Right-handed rotation about `axis` through the origin (Rodrigues)."""
     a = np.asarray(axis, dtype=float)
-    n = np.linalg.norm(a)
+    n = float(length3(a))
     if n == 0:
         raise ValueError("rotation axis must not be zero")
     x, y, z = a / n
-    th = np.radians(degrees)
-    c, s, C = np.cos(th), np.sin(th), 1 - np.cos(th)
+    th = np.radians(np.fmod(degrees, 360.0))                  # exact: sin and cos in their domain
+    c, s = float(cos(th)), float(sin(th))
+    C = 1 - c
     m = np.eye(4)
     m[:3, :3] = [[c + x * x * C, x * y * C - z * s, x * z * C + y * s],
                  [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
                  [z * x * C - y * s, z * y * C + x * s, c + z * z * C]]
-    return Transform(m, np.linalg.inv(m))
+    return Transform.from_matrix(m)
 
 
 def bounds_of_box(t: Transform, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -12,6 +12,8 @@ import functools
 import numpy as np
 
 from rtcli.core import camera as cameras
+from rtcli.core.elementary import cos
+from rtcli.core.vec import unit3
 from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
@@ -219,8 +221,7 @@ def light_from(p: Params) -> PointLight:
         angle = s.number("angle", 30.0)
         if not 0 < angle <= 180:
             raise s.error("angle", f"must be in (0, 180] degrees, got {angle:g}")
-        extra.update(spot_direction=direction / np.linalg.norm(direction),
-                     spot_cos=float(np.cos(np.radians(angle))),
+        extra.update(spot_direction=unit3(direction), spot_cos=float(cos(np.radians(angle))),
                      spot_falloff=s.number("falloff", 0.0, non_negative=True))
         s.check_unused()
     a = p.optional("area")

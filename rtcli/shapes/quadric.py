@@ -27,11 +27,11 @@ import math
 
 import numpy as np
 
+from rtcli.core.elementary import arctan2
 from rtcli.core.vec import cross3, dot, unit3
 from rtcli.shapes.base import Param, ParamError, Shape, ShapeKernels
 from rtcli.variants import (
     INF,
-    arctan2,
     copysign,
     isfinite,
     kernel,

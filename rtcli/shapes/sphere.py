@@ -10,12 +10,11 @@ import math
 
 import numpy as np
 
+from rtcli.core.elementary import arcsin, arctan2
 from rtcli.core.vec import dot
 from rtcli.shapes.base import Param, Shape, ShapeKernels
 from rtcli.variants import (
     INF,
-    arcsin,
-    arctan2,
     copysign,
     isfinite,
     kernel,

@@ -21,9 +21,8 @@ The roots, in closed form:
    resolvent cubic z^3 + 2a z^2 + (a^2 - 4e) z - b^2 = 0 (always >= 0).
 4. Each real root is polished by Newton steps on f(S0 + y c) (its exact expansion, without
    the rounding of |c| = 1 and S0.c = 0); t = (s0 + y) / |d|.
-The cubic's trigonometric solution uses arccos and cos, and its one-root form cbrt: the
-numpy variant of these may differ from the C library's by 1 ulp (rtcli/variants.py);
-Newton's steps then usually land both on the same root.
+The cubic's trigonometric solution uses arccos and cos, and its one-root form cbrt
+(rtcli/core/elementary.py).
 """
 
 from __future__ import annotations
@@ -32,15 +31,12 @@ import math
 
 import numpy as np
 
+from rtcli.core.elementary import arccos, arctan2, cbrt, cos
 from rtcli.core.vec import dot
 from rtcli.shapes.base import Param, Shape, ShapeKernels
 from rtcli.variants import (
     INF,
-    arccos,
-    arctan2,
-    cbrt,
     copysign,
-    cos,
     isfinite,
     kernel,
     maximum,
@@ -50,10 +46,6 @@ from rtcli.variants import (
 )
 
 MAJOR, MINOR = 0, 1                                   # the row: R, r
-# How far the numpy and scalar variants may differ (in ulps), where numpy takes cbrt and arccos from
-# SVML: the root polishing keeps t within 64 ulps; at a double root (a ray grazing the surface) t is
-# only defined to about sqrt(ulp), and measured within 2^16 ulps (about 1e-11 relative).
-ULPS, GRAZING_ULPS = 64, 1 << 16
 
 
 @kernel
