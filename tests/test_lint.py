@@ -255,3 +255,13 @@ def test_validate_s_summary_counts_in_singular_or_plural(run, tmp_path):
     assert run("validate", "one.yaml").stdout == (
         "one.yaml: ok: 1 object (1 sphere), 1 light, 1 material; 32x24, max_depth 5, phong, samples 1; "
         "animated: 1 frame at 24 fps (0..0.0416667 s), 1 keyframed value\n")
+
+
+def test_strict_with_keep_going_leaves_out_the_scenes_with_warnings(run, tmp_path):
+    (tmp_path / "scenes").mkdir()
+    (tmp_path / "scenes" / "a.yaml").write_text(SCENE)
+    (tmp_path / "scenes" / "b.yaml").write_text(CLEAN)
+    result = run("render", "scenes", "-o", "out", "--keep-going", "--strict")
+    assert result.exit_code == 2
+    assert result.stderr.splitlines()[0].startswith("error: scenes/a.yaml:4:44: objects[0].material.diffuse: ")
+    assert sorted(os.listdir(tmp_path / "out")) == ["b.png"]
