@@ -15,7 +15,7 @@ __version__ = "0.1.0"
 
 _EXPORTS = {
     "load_scene": "rtcli.api", "render": "rtcli.api", "signature": "rtcli.api", "legend": "rtcli.api",
-    "LegendRow": "rtcli.api", "diff": "rtcli.diffs", "Difference": "rtcli.diffs", "Scene": "rtcli.scene_api",
+    "LegendRow": "rtcli.api", "diff": "rtcli.compare.difference", "Difference": "rtcli.compare.difference", "Scene": "rtcli.scene_api",
     "ImageArray": "rtcli.results", "RenderStats": "rtcli.results", "RtcliError": "rtcli.errors",
     "SceneError": "rtcli.errors", "RtcliWarning": "rtcli.errors", "view": "rtcli.views", "explain": "rtcli.explain",
 }

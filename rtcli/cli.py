@@ -379,13 +379,13 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
     Given two folders, compare every .png in them paired by relative path: exit 0 when every
     pair passes, 1 when one fails or is missing or extra.
     """
-    from rtcli import compare as cmp
+    from rtcli.compare import images as cmp
     from rtcli.writer import write_images
     id_options = dict(max_boundary_mismatch=max_boundary_mismatch, max_boundary_fraction=max_boundary_fraction)
     image_options = dict(tolerance=tolerance, max_bad_pixels=max_bad_pixels,
                          max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
     if _folders(actual, expected, diff or flip_out or ids_mode, report_dir or junit_file):
-        from rtcli.compare_dirs import compare_dirs
+        from rtcli.compare.suite import compare_dirs
         if not compare_dirs(actual, expected, image_options, id_options, report_dir, junit_file, click.echo):
             raise click.exceptions.Exit(1)
         return
@@ -413,7 +413,7 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
 def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
     """Whether compare is given two folders; a usage error for a folder and a file, or for options
     of the other mode."""
-    from rtcli.compare_dirs import are_folders
+    from rtcli.compare.suite import are_folders
     folders = are_folders(actual, expected)
     if folders and pair_options:
         raise click.UsageError("--diff, --flip and --ids compare two images; two folders get --report")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtcli.compare import compare_ids, compare_images
+from rtcli.compare.images import compare_ids, compare_images
 from rtcli.render import Job, render
 
 SCENE = """

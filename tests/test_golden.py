@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from rtcli import compare
+from rtcli.compare import images as compare
 from rtcli.render import Job, render
 from rtcli.scenefile.build import load_scene
 from rtcli.writer import signature_colors, write_png

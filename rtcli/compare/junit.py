@@ -17,7 +17,7 @@ import socket
 import xml.etree.ElementTree as ET
 
 from rtcli.errors import one_line
-from rtcli.folders import Pair, total_line
+from rtcli.compare.folders import Pair, total_line
 from rtcli.writer import write_atomic
 
 

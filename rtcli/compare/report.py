@@ -21,10 +21,10 @@ import tempfile
 import numpy as np
 from PIL import Image
 
-from rtcli import compare as gate
+from rtcli.compare import images as gate
 from rtcli.errors import RtcliError, shown
-from rtcli.folders import Pair, comparable
-from rtcli.report_html import page
+from rtcli.compare.folders import Pair, comparable
+from rtcli.compare.report_html import page
 from rtcli.writer import current_umask, signature_colors
 
 MARKER = ".rtcli-report"

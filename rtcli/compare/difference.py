@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli import compare as gate
+from rtcli.compare import images as gate
 from rtcli.errors import RtcliError
 from rtcli.results import ImageArray, png_bytes
 
