@@ -17,7 +17,7 @@ _EXPORTS = {
     "load_scene": "rtcli.api", "render": "rtcli.api", "signature": "rtcli.api", "legend": "rtcli.api",
     "LegendRow": "rtcli.api", "diff": "rtcli.compare.difference", "Difference": "rtcli.compare.difference", "Scene": "rtcli.scene_api",
     "ImageArray": "rtcli.results", "RenderStats": "rtcli.results", "RtcliError": "rtcli.errors",
-    "SceneError": "rtcli.errors", "RtcliWarning": "rtcli.errors", "view": "rtcli.views", "explain": "rtcli.explain",
+    "SceneError": "rtcli.errors", "RtcliWarning": "rtcli.errors", "view": "rtcli.inspect.views", "explain": "rtcli.inspect.explain",
 }
 __all__ = ["__version__", *_EXPORTS]
 

@@ -20,7 +20,7 @@ from rtcli import __version__
 from rtcli.errors import Interrupted, RtcliError, error_line, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
-VIEWS = ("normal", "depth", "uv", "albedo", "bounces", "ids")          # rtcli/views.py, not imported to start
+VIEWS = ("normal", "depth", "uv", "albedo", "bounces", "ids")          # rtcli/inspect/views.py, not imported to start
 
 
 def _on_signal(signum, frame):
@@ -325,7 +325,7 @@ def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_sam
     """Explain why pixel (X, Y) has its color: its ray tree, every term of the shading equation
     with its numbers, and the sum at every ray (X from the left, Y from the top, from 0)."""
     from rtcli import runs
-    from rtcli.explain import explain as explain_pixel
+    from rtcli.inspect.explain import explain as explain_pixel
     if sample is not None and all_samples:
         raise click.UsageError("--sample and --all-samples go one at a time")
     _, scene = _load(scene_file, frame)
@@ -430,7 +430,8 @@ def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
 def validate(scene_file, list_objects, strict):
     """Parse and check a scene, every frame of an animated one; print a summary, and warnings about
     likely mistakes on stderr. Renders only a small signature (does the camera see anything?)."""
-    from rtcli import checks, lint
+    from rtcli.inspect import lint
+    from rtcli.inspect import checks
     from rtcli.frames import load
     from rtcli.scenefile.build import summary
     loaded = load(scene_file, lint=True)

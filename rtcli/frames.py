@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli import checks
+from rtcli.inspect import checks
 from rtcli.errors import RtcliError, shown
 from rtcli.movie import check_size, is_movie, movie_format, write_movie
 from rtcli.render import assemble, plan

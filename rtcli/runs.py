@@ -56,7 +56,7 @@ def note(text: str) -> None:
 def lint(quiet: bool, strict: bool, several: bool, watch: bool):
     """What render does with a scene's warnings (lint.Lint): printed on stderr (after the time
     in a watch, as its other lines), hidden by --quiet, errors with --strict."""
-    from rtcli.lint import Lint
+    from rtcli.inspect.lint import Lint
     return Lint(stamped if watch else echo_err, quiet, strict, several)
 
 
@@ -180,10 +180,10 @@ def missing(items: list, width, height) -> list:
 
 
 def view(scene, kind: str, width, height, tile: int, label: str | None):
-    """A debug view's picture (rtcli/views.py), its summary line printed; the ids view as its id
+    """A debug view's picture (rtcli/inspect/views.py), its summary line printed; the ids view as its id
     map, which `rtcli compare --ids` reads (README.md, Commands)."""
     from rtcli.results import ImageArray
-    from rtcli.views import summary, view
+    from rtcli.inspect.views import summary, view
     data = view(scene, kind, width=width, height=height, tile=tile)
     click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
     return data if data.is_ids else ImageArray(data.to_8bit(), inputs=scene.inputs)

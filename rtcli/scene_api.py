@@ -100,7 +100,7 @@ def load(source: Source, folder: str | None = None, frame: int | None = None, op
     """The Scene of a path, YAML text or a dict (see rtcli.load_scene for which is which), at frame
     `frame` of an animated scene (default 1); `option` names the frame in messages. Its warnings
     (`rtcli validate`'s, about frame 1) are raised as Python warnings (rtcli.RtcliWarning)."""
-    from rtcli import lint
+    from rtcli.inspect import lint
     scene, found = _load(source, folder, frame, option)
     lint.warn(found)
     return scene
@@ -108,7 +108,7 @@ def load(source: Source, folder: str | None = None, frame: int | None = None, op
 
 def _load(source: Source, folder: str | None, frame: int | None, option: str):
     """The Scene and its warnings (checks.Remark)."""
-    from rtcli import checks
+    from rtcli.inspect import checks
     from rtcli.scenefile import yamlfile
     from rtcli.scenefile.animation import Animation
     from rtcli.scenefile.files import reading_scene

@@ -19,7 +19,7 @@ from click.testing import CliRunner
 import rtcli
 from rtcli import compiled
 from rtcli.cli import main
-from rtcli.explain import Recorder
+from rtcli.inspect.explain import Recorder
 from rtcli.render import Job, render_tile
 
 SCENES = sorted(str(p) for p in (Path(__file__).parent.parent / "scenes").glob("*.yaml"))

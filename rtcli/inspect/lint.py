@@ -15,7 +15,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from rtcli import checks
+from rtcli.inspect import checks
 from rtcli.errors import RtcliWarning, one_line, shown
 from rtcli.scenefile.remarks import Remark
 
