@@ -5,7 +5,7 @@
 
 The API (docs/python-api.md) is imported on first use, so `import rtcli` stays cheap
 for the command line. `rtcli.render` is the API's function; the tile renderer it
-drives is the module of the same name, imported as `from rtcli.render import ...`.
+drives is the module of the same name, imported as `from rtcli.rendering.tiles import ...`.
 """
 
 import sys
@@ -38,7 +38,7 @@ def __dir__() -> list:
 
 class _Package(types.ModuleType):
     """This package, whose API names win over submodules of the same name: importing a submodule
-    sets the package's attribute of that name (rtcli.render the module would hide rtcli.render
+    sets the package's attribute of that name (rtcli.rendering.tiles the module would hide rtcli.rendering.tiles
     the function); here that attribute is left to the API. The submodule stays in sys.modules."""
 
     def __setattr__(self, name, value):

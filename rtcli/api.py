@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.errors import RtcliError, shown
-from rtcli.render import TILE
+from rtcli.rendering.tiles import TILE
 from rtcli.results import ImageArray, RenderStats
 from rtcli.scene_api import Scene, Source, check_options, image_size, load
 
@@ -82,7 +82,7 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
         (notes or _warn)(note)
     if output is not None:
         _check_output(os.fspath(output), scene, False)
-    from rtcli.render import Job
+    from rtcli.rendering.tiles import Job
     job = Job(w, h, block_size, tile=tile, gamma=gamma, engine=engine, bvh=bvh, linear=linear)
     with scene.model.settings.overridden(samples, max_depth) as s:
         pixels, counts, seconds = _run(scene, job, workers, progress, notes)
@@ -105,7 +105,7 @@ def signature(scene: Scene | Source, *, width: int | None = None, height: int | 
     check_ids(scene)
     if output is not None:
         _check_output(os.fspath(output), scene, True)
-    from rtcli.render import Job
+    from rtcli.rendering.tiles import Job
     w, h, _ = image_size(scene.model, width, height)
     ids, counts, seconds = _run(scene, Job(w, h, block_size, signature=True), workers, None, None)
     image = ImageArray(ids, RenderStats.of(w, h, 1, counts, seconds), scene.inputs)
@@ -145,7 +145,7 @@ def _warn(note: str) -> None:
 def _run(scene: Scene, job, workers: int | None, progress, notes):
     """The pixels, the counts, and the seconds of the render without the compiled code's start-up
     (counts.load_seconds)."""
-    from rtcli.render import render as render_image
+    from rtcli.rendering.tiles import render as render_image
     start = time.perf_counter()
     pixels, counts = render_image(scene.model, job, workers or os.cpu_count() or 1, progress, notes)
     return pixels, counts, time.perf_counter() - start - counts.load_seconds
@@ -160,5 +160,5 @@ def check_engine(engine: str) -> None:
 
 
 def _check_output(path: str, scene: Scene, ids: bool) -> None:
-    from rtcli.outputs import check_outputs
+    from rtcli.rendering.outputs import check_outputs
     check_outputs([(path, ids)], list(scene.inputs))

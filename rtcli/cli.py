@@ -92,7 +92,7 @@ def _load(path: str, frame: int | None = None, keep: bool = False, lint=None, **
     """(frames.Loaded, api.Scene) of a scene file at frame `frame` (default 1), with the command
     line's overrides; `keep`: also the files' bytes, for a cluster; `lint` (lint.Lint): what to
     do with its warnings."""
-    from rtcli.frames import load
+    from rtcli.rendering.frames import load
     from rtcli.scene_api import of_loaded
     loaded = load(path, frame, keep=keep, lint=lint is not None and lint.wanted)
     if lint is not None:
@@ -111,7 +111,7 @@ def _output(scene_path: str, out: str | None, suffix: str = ".png") -> str:
 
 
 def _check_outputs(outputs, inputs) -> None:
-    from rtcli.outputs import check_outputs
+    from rtcli.rendering.outputs import check_outputs
     check_outputs(outputs, inputs)
 
 
@@ -139,7 +139,7 @@ def _cluster(address, file, local):
         return None
     from rtcli import runs
     from rtcli.cluster import target
-    from rtcli.frames import Reach
+    from rtcli.rendering.frames import Reach
     return Reach(target(address, file, local), runs.note)
 
 
@@ -188,9 +188,10 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
            strict, keep_going, cluster, cluster_file, local_cluster, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
-    from rtcli import api, batch, runs
-    from rtcli import frames as animation
-    from rtcli.movie import is_movie
+    from rtcli import api, runs
+    from rtcli.rendering import batch
+    from rtcli.rendering import frames as animation
+    from rtcli.rendering.movie import is_movie
     if as_json and not stats:
         raise click.UsageError("--json goes with --stats")
     if view and stats:
@@ -286,7 +287,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     import numpy as np
 
     from rtcli import api, runs
-    from rtcli.writer import signature_colors, write_images
+    from rtcli.rendering.writer import signature_colors, write_images
     where = _cluster(cluster, cluster_file, local_cluster)
     loaded, scene = _load(scene_file, frame, keep=where is not None)
     out = _output(scene_file, output, ".sig.png")
@@ -380,7 +381,7 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
     pair passes, 1 when one fails or is missing or extra.
     """
     from rtcli.compare import images as cmp
-    from rtcli.writer import write_images
+    from rtcli.rendering.writer import write_images
     id_options = dict(max_boundary_mismatch=max_boundary_mismatch, max_boundary_fraction=max_boundary_fraction)
     image_options = dict(tolerance=tolerance, max_bad_pixels=max_bad_pixels,
                          max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
@@ -432,7 +433,7 @@ def validate(scene_file, list_objects, strict):
     likely mistakes on stderr. Renders only a small signature (does the camera see anything?)."""
     from rtcli.inspect import lint
     from rtcli.inspect import checks
-    from rtcli.frames import load
+    from rtcli.rendering.frames import load
     from rtcli.scenefile.build import summary
     loaded = load(scene_file, lint=True)
     frames = loaded.animation.check_all()

@@ -4,7 +4,7 @@ A still goes out as groups of tiles, about RAYS_PER_TASK primary rays each and a
 least TASKS_PER_WORKER per worker, so that Dask's few milliseconds a task stay small
 and every worker has work until the end; an animation goes out a frame a task. Every
 pixel depends only on the scene and the pixel (jitter is hashed from the pixel's
-coordinates, rtcli/render.py), so the images are byte for byte the ones a local render
+coordinates, rtcli/rendering/tiles.py), so the images are byte for byte the ones a local render
 makes, whatever the cluster's size, the grouping, or a worker that dies and whose
 tasks run again elsewhere.
 
@@ -207,7 +207,7 @@ def _scene(spec: dict, blobs: dict, frame: int):
     with serving(files):
         animation = _kept(_animations, spec["key"], lambda: Animation(yamlfile.load(spec["scene_path"])), 2)
         scene = animation.scene(frame)
-    from rtcli.frames import apply
+    from rtcli.rendering.frames import apply
     return apply(scene, spec["overrides"])
 
 
@@ -226,8 +226,8 @@ def _worker_address() -> str:
 
 
 def tiles_task(spec: dict, blobs: dict, frame: int, job, traced: int, tiles: list) -> list:
-    """Trace a group of tiles of `frame`: [(rows, cols, values, stats)], as rtcli.render.run_tiles."""
-    from rtcli.render import run_tiles
+    """Trace a group of tiles of `frame`: [(rows, cols, values, stats)], as rtcli.rendering.tiles.run_tiles."""
+    from rtcli.rendering.tiles import run_tiles
     try:
         _checked(spec)
         with _lock:
@@ -243,7 +243,7 @@ def tiles_task(spec: dict, blobs: dict, frame: int, job, traced: int, tiles: lis
 
 def _prepared(spec, blobs, frame, job, traced):
     """(scene, engine) of `frame`; the engine's notes, and its compile time, told to the client."""
-    from rtcli.render import prepare
+    from rtcli.rendering.tiles import prepare
     scene, notes = _scene(spec, blobs, frame), told()
     engine, load = prepare(scene, job, traced, notes)
     if notes and load:
@@ -253,7 +253,7 @@ def _prepared(spec, blobs, frame, job, traced):
 
 def frame_task(spec: dict, blobs: dict, frame: int, job):
     """Render a whole frame here, one tile after another: (frame, image, stats)."""
-    from rtcli.render import render
+    from rtcli.rendering.tiles import render
     try:
         _checked(spec)
         with _lock:

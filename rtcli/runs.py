@@ -12,7 +12,7 @@ import time
 import click
 
 from rtcli.errors import one_line, shown
-from rtcli.outputs import check_outputs
+from rtcli.rendering.outputs import check_outputs
 
 
 def size(model, width, height) -> tuple[int, int]:
@@ -75,13 +75,13 @@ def clock() -> str:
 
 
 def make_job(model, width, height, block_size, **kw):
-    from rtcli.render import Job
+    from rtcli.rendering.tiles import Job
     return Job(*size(model, width, height), block_size, **kw)
 
 
 def on_cluster(loaded, scene, where, changes: dict, width, height, block_size, progress=None, **kw):
     """The still (frames.render_image) of `loaded` traced on the cluster, as api.render returns it."""
-    from rtcli.frames import overrides, render_image
+    from rtcli.rendering.frames import overrides, render_image
     from rtcli.results import ImageArray, RenderStats
     job = make_job(scene.model, width, height, block_size, **kw)
     start = time.perf_counter()
@@ -96,8 +96,8 @@ def render_frames(scene_file: str, output, frame_range, frame, movie, skip_exist
                   changes: dict, workers, bar: bool, stats, lint=None) -> None:
     """An animation's frames to files or movies (frames.py), each file written as its frame is done;
     `stats`: None, "line" or "json"; `lint` (lint.Lint): what to do with the scene's warnings."""
-    from rtcli import batch
-    from rtcli import frames as animation
+    from rtcli.rendering import batch
+    from rtcli.rendering import frames as animation
     start = time.perf_counter()
     loaded = animation.load(scene_file, None, keep=where is not None, lint=lint is not None and lint.wanted)
     if lint is not None:
@@ -118,7 +118,7 @@ def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: 
                      skip_existing: bool, start: float) -> None:
     import json
 
-    from rtcli import frames as animation
+    from rtcli.rendering import frames as animation
     from rtcli.results import RenderStats
     scene = loaded.scene
     animation.apply(scene, changes)            # the other frames are checked as written, then changed alike
@@ -143,9 +143,9 @@ def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: 
 def watch_scene(item, load, render_one, stats: bool, as_json: bool) -> None:
     """render --watch: the scene to its image now and after every change, until Ctrl-C. With
     --json, stdout holds only the JSON lines (the watch's own lines go to stderr)."""
-    from rtcli import batch
-    from rtcli.outputs import check_file_output
-    from rtcli.watch import watch
+    from rtcli.rendering import batch
+    from rtcli.rendering.outputs import check_file_output
+    from rtcli.rendering.watch import watch
     check_file_output(item.output, [item.scene])        # the scene as its own output: refused at once
 
     def once() -> None:
@@ -165,7 +165,7 @@ def missing(items: list, width, height) -> list:
     scene renders at (an image of another size is rendered again). A scene whose image exists is
     loaded to learn its size; one that fails to load stays in, to fail where it renders."""
     from rtcli.errors import RtcliError
-    from rtcli.frames import has_image, load
+    from rtcli.rendering.frames import has_image, load
     todo = []
     for item in items:
         if os.path.isfile(item.output):

@@ -123,7 +123,7 @@ def _load(source: Source, folder: str | None, frame: int | None, option: str):
     elif isinstance(source, (str, os.PathLike)):
         if folder is not None:
             raise TypeError("folder= is for YAML text and dicts; a scene file's names are relative to its folder")
-        from rtcli.frames import load as load_file
+        from rtcli.rendering.frames import load as load_file
         path = os.fspath(source)
         loaded = load_file(path, frame, option=option, lint=True)
         return of_loaded(loaded, path), loaded.warnings
@@ -140,7 +140,7 @@ def _load(source: Source, folder: str | None, frame: int | None, option: str):
 
 
 def of_loaded(loaded, path: str) -> Scene:
-    """The Scene of a scene file loaded for the command line (rtcli.frames.Loaded)."""
+    """The Scene of a scene file loaded for the command line (rtcli.rendering.frames.Loaded)."""
     animation = None if loaded.animation.still else loaded.animation
     return Scene(loaded.scene, path, loaded.inputs, animation, loaded.frame, warnings=loaded.warnings)
 

@@ -17,7 +17,8 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from rtcli import variants, writer
+from rtcli import variants
+from rtcli.rendering import writer
 from rtcli.cli import main
 
 SCENE = """\

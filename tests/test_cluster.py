@@ -28,11 +28,12 @@ from click.testing import CliRunner
 from PIL import Image
 
 from rtcli import cluster as dask_cluster
-from rtcli import frames, runs, variants
+from rtcli import runs, variants
+from rtcli.rendering import frames
 from rtcli.cli import main
 from rtcli.compiled.loading import Load
 from rtcli.errors import RtcliError
-from rtcli.render import Job, render
+from rtcli.rendering.tiles import Job, render
 
 distributed = pytest.importorskip("distributed")
 
@@ -307,7 +308,7 @@ COMPILING = "compiling the render engine, once (about a minute); cached in /some
 def compiling(monkeypatch):
     """The engine's start-up on the `threads` workers (whose tasks give notes) replaced by one that says it compiles, waits
     until `heard` is set (at most 60 s; whether it was, in `waited`), and reports 2.5 s of compiling."""
-    rendering = sys.modules["rtcli.render"]              # the module (rtcli.render is also rtcli's function)
+    rendering = sys.modules["rtcli.rendering.tiles"]
     real, heard, waited = rendering.prepare, threading.Event(), []
 
     def prepare(scene, job, traced, notes=None):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rtcli.compare.images import compare_ids, compare_images
-from rtcli.render import Job, render
+from rtcli.rendering.tiles import Job, render
 
 SCENE = """
 image: {{width: 160, height: 120}}

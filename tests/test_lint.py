@@ -16,7 +16,7 @@ from helpers import scene_from_yaml
 
 import rtcli
 from rtcli.inspect import checks
-from rtcli import watch as watching
+from rtcli.rendering import watch as watching
 from rtcli.cli import main
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays

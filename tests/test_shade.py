@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from helpers import one_pixel, scene_from_yaml
 
-from rtcli.render import camera_rays
+from rtcli.rendering.tiles import camera_rays
 from rtcli.wavefront.intersect import find_first_hit
 
 RTOL = 1e-9

@@ -266,7 +266,7 @@ def test_after_warmup_no_scene_compiles_anything(warm, monkeypatch):
     the integrator's machine code file, and through numba there is one machine code each."""
     from rtcli.compiled import query
     from rtcli.compiled.integrator import trace_camera
-    from rtcli.render import Job, render
+    from rtcli.rendering.tiles import Job, render
     from rtcli.scenefile.build import load_scene
     scenes = [load_scene(str(p)) for p in sorted((ROOT / "scenes").glob("*.yaml")) +
               sorted((ROOT / "bench").glob("*.yaml"))]

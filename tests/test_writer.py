@@ -9,7 +9,7 @@ import pytest
 from PIL import Image
 
 from rtcli.errors import RtcliError
-from rtcli.writer import palette, srgb_encode, to_8bit, write_png
+from rtcli.rendering.writer import palette, srgb_encode, to_8bit, write_png
 
 
 def test_to_8bit_clamps_and_rounds():

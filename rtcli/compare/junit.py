@@ -18,7 +18,7 @@ import xml.etree.ElementTree as ET
 
 from rtcli.errors import one_line
 from rtcli.compare.folders import Pair, total_line
-from rtcli.writer import write_atomic
+from rtcli.rendering.writer import write_atomic
 
 
 def junit_xml(pairs: list[Pair], properties: dict[str, str], seconds: float) -> bytes:

@@ -25,7 +25,7 @@ from rtcli.compare import images as gate
 from rtcli.errors import RtcliError, shown
 from rtcli.compare.folders import Pair, comparable
 from rtcli.compare.report_html import page
-from rtcli.writer import current_umask, signature_colors
+from rtcli.rendering.writer import current_umask, signature_colors
 
 MARKER = ".rtcli-report"
 

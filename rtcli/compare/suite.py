@@ -59,7 +59,7 @@ def are_folders(actual: str, expected: str) -> bool:
 
 
 def _check_outputs(actual: str, expected: str, report: str | None, junit: str | None) -> None:
-    from rtcli.outputs import check_file_output
+    from rtcli.rendering.outputs import check_file_output
     from rtcli.compare.report import check_report_dir
     inputs = list(images_under(actual).values()) + list(images_under(expected).values())
     if report:

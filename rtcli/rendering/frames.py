@@ -22,12 +22,12 @@ import numpy as np
 
 from rtcli.inspect import checks
 from rtcli.errors import RtcliError, shown
-from rtcli.movie import check_size, is_movie, movie_format, write_movie
-from rtcli.render import assemble, plan
-from rtcli.render import render as render_tiles  # `from rtcli import render` is the API function
+from rtcli.rendering.movie import check_size, is_movie, movie_format, write_movie
+from rtcli.rendering.tiles import assemble, plan
+from rtcli.rendering.tiles import render as render_tiles  # `from rtcli import render` is the API function
 from rtcli.scenefile.animation import Animation, load_animation
 from rtcli.stats import Stats
-from rtcli.writer import write_png
+from rtcli.rendering.writer import write_png
 
 PATTERN = re.compile(r"(?:[^%]|%%)*%0?[1-9]?\d*d(?:[^%]|%%)*", re.DOTALL)    # exactly one %d, %04d ...
 

@@ -24,12 +24,12 @@ from rtcli import compiled, variants, wavefront
 from rtcli.core.camera import primary_ray
 from rtcli.core.jitter import hash_pixel
 from rtcli.core.scene import Scene
-from rtcli.pool import held_signals, stop_pool, watch_worker, worker_died
+from rtcli.rendering.pool import held_signals, stop_pool, watch_worker, worker_died
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays
 from rtcli.wavefront.trace import trace
-from rtcli.writer import to_8bit
+from rtcli.rendering.writer import to_8bit
 
 TILE = 128                                 # tile edge in pixels (rays per tile: TILE^2 x samples^2)
 
