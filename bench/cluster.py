@@ -88,8 +88,9 @@ def task_costs(address: str, workers: int, runs: int = 200) -> tuple[float, floa
     """(work, round trip, busy time a task adds to a worker), in seconds, of tile groups of one
     pixel of the Whitted scene, whose built scene every worker keeps after its first task."""
     sys.path.insert(0, ROOT)
-    from rtcli import cluster, frames
-    from rtcli.render import Job, plan, prepare, run_tiles
+    from rtcli import cluster
+    from rtcli.rendering import frames
+    from rtcli.rendering.tiles import Job, plan, prepare, run_tiles
     loaded = frames.load(os.path.join(ROOT, "scenes", "whitted.yaml"), keep=True)
     job = Job(1, 1)
     tiles, traced = plan(loaded.scene, job)
@@ -119,7 +120,7 @@ def task_costs(address: str, workers: int, runs: int = 200) -> tuple[float, floa
 
 def bundle_sizes() -> list[tuple[str, int, int]]:
     sys.path.insert(0, ROOT)
-    from rtcli import frames
+    from rtcli.rendering import frames
     out = []
     for name in sorted(os.listdir(os.path.join(ROOT, "scenes"))):
         if name.endswith(".yaml"):

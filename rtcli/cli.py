@@ -287,7 +287,8 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     import numpy as np
 
     from rtcli import api, runs
-    from rtcli.rendering.writer import signature_colors, write_images
+    from rtcli.core.display import signature_colors
+    from rtcli.rendering.writer import write_images
     where = _cluster(cluster, cluster_file, local_cluster)
     loaded, scene = _load(scene_file, frame, keep=where is not None)
     out = _output(scene_file, output, ".sig.png")
@@ -431,8 +432,7 @@ def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
 def validate(scene_file, list_objects, strict):
     """Parse and check a scene, every frame of an animated one; print a summary, and warnings about
     likely mistakes on stderr. Renders only a small signature (does the camera see anything?)."""
-    from rtcli.inspect import lint
-    from rtcli.inspect import checks
+    from rtcli.inspect import checks, lint
     from rtcli.rendering.frames import load
     from rtcli.scenefile.build import summary
     loaded = load(scene_file, lint=True)

@@ -101,7 +101,7 @@ class ImageArray(np.ndarray):
         """The 8-bit image: linear colors clamped to [0, 1], optionally sRGB-encoded, rounded; an id
         map as its signature picture (a fixed color per id, as `rtcli signature` draws it); a
         debug view as its picture."""
-        from rtcli.rendering.writer import signature_colors, to_8bit
+        from rtcli.core.display import signature_colors, to_8bit
         if self.picture is not None:
             return ImageArray(self.picture, inputs=self.inputs)
         if self.is_ids:

@@ -182,8 +182,8 @@ def missing(items: list, width, height) -> list:
 def view(scene, kind: str, width, height, tile: int, label: str | None):
     """A debug view's picture (rtcli/inspect/views.py), its summary line printed; the ids view as its id
     map, which `rtcli compare --ids` reads (README.md, Commands)."""
-    from rtcli.results import ImageArray
     from rtcli.inspect.views import summary, view
+    from rtcli.results import ImageArray
     data = view(scene, kind, width=width, height=height, tile=tile)
     click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
     return data if data.is_ids else ImageArray(data.to_8bit(), inputs=scene.inputs)

@@ -13,7 +13,7 @@ import yaml
 from PIL import Image
 
 import rtcli
-from rtcli.rendering.writer import to_8bit
+from rtcli.core.display import to_8bit
 
 SCENE = """\
 image: {width: 32, height: 24}

@@ -12,7 +12,7 @@ from helpers import scene_from_yaml
 
 from rtcli.core import camera as cameras
 from rtcli.errors import SceneError
-from rtcli.rendering.tiles import camera_rays
+from rtcli.wavefront.rays import camera_rays
 
 EYE, LOOK, UP = np.array([1.0, 2.0, 3.0]), np.array([-2.0, 0.5, -1.0]), np.array([0.2, 1.0, 0.1])
 

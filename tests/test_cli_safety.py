@@ -18,8 +18,8 @@ from click.testing import CliRunner
 from PIL import Image
 
 from rtcli import variants
-from rtcli.rendering import writer
 from rtcli.cli import main
+from rtcli.rendering import writer
 
 SCENE = """\
 image: {width: 32, height: 24}

@@ -29,10 +29,10 @@ from PIL import Image
 
 from rtcli import cluster as dask_cluster
 from rtcli import runs, variants
-from rtcli.rendering import frames
 from rtcli.cli import main
 from rtcli.compiled.loading import Load
 from rtcli.errors import RtcliError
+from rtcli.rendering import frames
 from rtcli.rendering.tiles import Job, render
 
 distributed = pytest.importorskip("distributed")

@@ -12,13 +12,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import without_avx512
 
 from rtcli import compiled as fast
 from rtcli import variants
 from rtcli.errors import RtcliError
 from rtcli.rendering.tiles import Job, render, render_tile
 from rtcli.scenefile.build import load_scene
-from helpers import without_avx512
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 
@@ -465,11 +465,11 @@ def test_numpys_two_code_paths_and_both_engines_give_the_same_bytes(tmp_path):
     (tmp_path / "random.yaml").write_text(random_csg_scene(11, SOLIDS))
     paths = [str(ROOT / "scenes" / f"{name}.yaml") for name in CPU_SENSITIVE] + [str(tmp_path / "random.yaml")]
     code = ("import sys, numpy as np; from rtcli.rendering.tiles import Job, render; from rtcli.scenefile.build import "
-            "load_scene; from rtcli.rendering.writer import to_8bit; "
+            "load_scene; from rtcli.core.display import to_8bit; "
             "[np.save(f'{sys.argv[1]}/{k}.npy', to_8bit(render(load_scene(p), Job(80, 60, engine='numpy'))[0], "
             "gamma=True)) for k, p in enumerate(sys.argv[2:])]")
     without_avx512(["-c", code, str(tmp_path), *paths])
-    from rtcli.rendering.writer import to_8bit
+    from rtcli.core.display import to_8bit
     for k, path in enumerate(paths):
         other = np.load(tmp_path / f"{k}.npy")
         for engine in ("numpy", "compiled"):

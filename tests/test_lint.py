@@ -15,9 +15,9 @@ from click.testing import CliRunner
 from helpers import scene_from_yaml
 
 import rtcli
+from rtcli.cli import main
 from rtcli.inspect import checks
 from rtcli.rendering import watch as watching
-from rtcli.cli import main
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays
 

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from helpers import scene_from_yaml
 
-from rtcli.rendering.tiles import Job, render, sample_positions
+from rtcli.core.jitter import sample_positions
+from rtcli.rendering.tiles import Job, render
 
 W, H = 23, 17                       # not multiples of the block or tile sizes
 
@@ -101,8 +102,9 @@ def test_samples_2_is_close_different_and_deterministic(reference):
 
 def test_a_pixel_is_the_mean_of_its_samples():
     """With samples n, a pixel's float color is the mean of the n x n rays traced at sample_positions."""
-    from rtcli.rendering.tiles import camera_rays, render_tile
+    from rtcli.rendering.tiles import render_tile
     from rtcli.stats import Stats
+    from rtcli.wavefront.rays import camera_rays
     from rtcli.wavefront.trace import trace
     scene2 = scene_from_yaml(SCENE.format(samples=2))
     i, j = np.array([3, 11, 20, 7]), np.array([2, 8, 15, 12])

@@ -81,6 +81,6 @@ def pixels(image, name: str = "image") -> np.ndarray:
     if array.dtype.kind == "f":
         if array.ndim != 3 or array.shape[2] != 3:
             raise RtcliError(f"{name} is not an RGB image (H, W, 3): got {array.dtype} array of shape {array.shape}")
-        from rtcli.rendering.writer import to_8bit
+        from rtcli.core.display import to_8bit
         return to_8bit(array)
     return array

@@ -16,8 +16,8 @@ import datetime
 import socket
 import xml.etree.ElementTree as ET
 
-from rtcli.errors import one_line
 from rtcli.compare.folders import Pair, total_line
+from rtcli.errors import one_line
 from rtcli.rendering.writer import write_atomic
 
 

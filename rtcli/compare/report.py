@@ -22,10 +22,11 @@ import numpy as np
 from PIL import Image
 
 from rtcli.compare import images as gate
-from rtcli.errors import RtcliError, shown
 from rtcli.compare.folders import Pair, comparable
 from rtcli.compare.report_html import page
-from rtcli.rendering.writer import current_umask, signature_colors
+from rtcli.core.display import signature_colors
+from rtcli.errors import RtcliError, shown
+from rtcli.rendering.writer import current_umask
 
 MARKER = ".rtcli-report"
 

@@ -13,8 +13,8 @@ import os
 import time
 from collections.abc import Callable
 
-from rtcli.errors import RtcliError, shown
 from rtcli.compare.folders import compare_folders, images_under, total_line
+from rtcli.errors import RtcliError, shown
 
 
 def compare_dirs(actual: str, expected: str, image_options: dict, id_options: dict, report: str | None,
@@ -59,8 +59,8 @@ def are_folders(actual: str, expected: str) -> bool:
 
 
 def _check_outputs(actual: str, expected: str, report: str | None, junit: str | None) -> None:
-    from rtcli.rendering.outputs import check_file_output
     from rtcli.compare.report import check_report_dir
+    from rtcli.rendering.outputs import check_file_output
     inputs = list(images_under(actual).values()) + list(images_under(expected).values())
     if report:
         check_report_dir(report, [actual, expected])

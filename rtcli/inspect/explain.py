@@ -22,11 +22,12 @@ import numpy as np
 from rtcli.core.lights import COLOR, POSITION, attenuation, spot_factor
 from rtcli.core.scene import Scene
 from rtcli.errors import RtcliError
-from rtcli.inspect.raytree import Hit, Feeler, LightSample, LightTerm, Glass, RayNode, Explanation
+from rtcli.inspect.raytree import Explanation, Feeler, Glass, Hit, LightSample, LightTerm, RayNode
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays
 from rtcli.wavefront.trace import Log
+
 
 class Recorder(Log):
     """The engine's recorder (wavefront/trace.py) for one ray: fills a RayNode."""
@@ -117,7 +118,7 @@ def coefficients(table, m: int) -> dict:
 
 def trace_one(scene: Scene, x: float, y: float, width: int, height: int) -> RayNode:
     """The tree of the primary ray through image position (x, y) of a width x height image."""
-    from rtcli.rendering.tiles import camera_rays
+    from rtcli.wavefront.rays import camera_rays
     from rtcli.wavefront.trace import trace
     rays = camera_rays(scene.camera(width, height), np.array([x]), np.array([y]), width, height)
     root = RayNode("primary", 1, rays.o[:, 0], rays.d[:, 0])
@@ -132,10 +133,10 @@ def explain(scene, x: int, y: int, *, width: int | None = None, height: int | No
     """The ray trees of pixel (x, y) (column from the left, row from the top) of a Scene, or of
     what rtcli.load_scene takes; the size and settings as `rtcli.render` takes them."""
     from rtcli import api, wavefront
-    from rtcli.rendering.tiles import sample_positions
+    from rtcli.core.display import to_8bit
+    from rtcli.core.jitter import sample_positions
     from rtcli.scene_api import Scene as Loaded
     from rtcli.scene_api import check_options
-    from rtcli.rendering.writer import to_8bit
     check_options(width=width, height=height, samples=samples, max_depth=max_depth)
     if not isinstance(scene, Loaded):
         scene = api.load_scene(scene, width=width, height=height)

@@ -83,9 +83,9 @@ _MISS = {"normal": 0.0, "depth": np.inf, "uv": np.nan, "albedo": 0.0, "bounces":
 
 def _tile(model, kind: str, cam, ii, jj, w: int, h: int) -> np.ndarray:
     """The view's values at pixels (ii, jj): (n,) or (n, channels)."""
-    from rtcli.rendering.tiles import camera_rays
     from rtcli.stats import Stats
     from rtcli.wavefront.intersect import find_first_hit, surface, uv_at_hits
+    from rtcli.wavefront.rays import camera_rays
     from rtcli.wavefront.trace import trace
     rays = camera_rays(cam, ii + 0.5, jj + 0.5, w, h)
     if kind == "bounces":
@@ -108,7 +108,7 @@ def _tile(model, kind: str, cam, ii, jj, w: int, h: int) -> np.ndarray:
 
 def picture(data: np.ndarray, kind: str, max_depth: int = 5) -> np.ndarray:
     """How a view shows, 8-bit (H, W, 3) (see the module's docstring)."""
-    from rtcli.rendering.writer import signature_colors, to_8bit
+    from rtcli.core.display import signature_colors, to_8bit
     data = np.asarray(data)
     if kind == "ids":
         return signature_colors(data)

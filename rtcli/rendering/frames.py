@@ -20,14 +20,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli.inspect import checks
 from rtcli.errors import RtcliError, shown
+from rtcli.inspect import checks
 from rtcli.rendering.movie import check_size, is_movie, movie_format, write_movie
 from rtcli.rendering.tiles import assemble, plan
 from rtcli.rendering.tiles import render as render_tiles  # `from rtcli import render` is the API function
+from rtcli.rendering.writer import write_png
 from rtcli.scenefile.animation import Animation, load_animation
 from rtcli.stats import Stats
-from rtcli.rendering.writer import write_png
 
 PATTERN = re.compile(r"(?:[^%]|%%)*%0?[1-9]?\d*d(?:[^%]|%%)*", re.DOTALL)    # exactly one %d, %04d ...
 

@@ -13,8 +13,8 @@ import os
 import stat
 
 from rtcli.errors import RtcliError, shown
-from rtcli.scenefile.files import kind_of
 from rtcli.rendering.writer import image_format
+from rtcli.scenefile.files import kind_of
 
 
 def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> None:
