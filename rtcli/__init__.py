@@ -14,10 +14,11 @@ import types
 __version__ = "0.1.0"
 
 _EXPORTS = {
-    "load_scene": "rtcli.api", "render": "rtcli.api", "signature": "rtcli.api", "legend": "rtcli.api",
-    "LegendRow": "rtcli.api", "diff": "rtcli.compare.difference", "Difference": "rtcli.compare.difference", "Scene": "rtcli.scene_api",
-    "ImageArray": "rtcli.results", "RenderStats": "rtcli.results", "RtcliError": "rtcli.errors",
-    "SceneError": "rtcli.errors", "RtcliWarning": "rtcli.errors", "view": "rtcli.inspect.views", "explain": "rtcli.inspect.explain",
+    "load_scene": "rtcli.api", "render": "rtcli.api", "signature": "rtcli.api", "view": "rtcli.api",
+    "explain": "rtcli.api", "legend": "rtcli.api.pictures", "LegendRow": "rtcli.api.pictures",
+    "Scene": "rtcli.api.scene", "ImageArray": "rtcli.api.results", "RenderStats": "rtcli.api.results",
+    "diff": "rtcli.compare.difference", "Difference": "rtcli.compare.difference", "RtcliError": "rtcli.errors",
+    "SceneError": "rtcli.errors", "RtcliWarning": "rtcli.errors",
 }
 __all__ = ["__version__", *_EXPORTS]
 

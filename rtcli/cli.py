@@ -92,9 +92,8 @@ def _load(path: str, frame: int | None = None, keep: bool = False, lint=None, **
     """(frames.Loaded, api.Scene) of a scene file at frame `frame` (default 1), with the command
     line's overrides; `keep`: also the files' bytes, for a cluster; `lint` (lint.Lint): what to
     do with its warnings."""
-    from rtcli.rendering.frames import load
-    from rtcli.scene_api import of_loaded
-    loaded = load(path, frame, keep=keep, lint=lint is not None and lint.wanted)
+    from rtcli.api.loading import load_file, of_loaded
+    loaded = load_file(path, frame, keep=keep, lint=lint is not None and lint.wanted)
     if lint is not None:
         lint.report(loaded.warnings, path, loaded.animation.frames)
     return loaded, of_loaded(loaded, path).override(**overrides)
@@ -138,8 +137,8 @@ def _cluster(address, file, local):
     if not (address or file or local):
         return None
     from rtcli import runs
-    from rtcli.cluster import target
-    from rtcli.rendering.frames import Reach
+    from rtcli.cluster.renders import Reach
+    from rtcli.cluster.target import target
     return Reach(target(address, file, local), runs.note)
 
 
@@ -189,6 +188,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
     from rtcli import api, runs
+    from rtcli.api.options import check_engine
     from rtcli.rendering import batch
     from rtcli.rendering import frames as animation
     from rtcli.rendering.movie import is_movie
@@ -206,7 +206,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
                                "or a movie")
     if view and (cluster or cluster_file or local_cluster):
         raise click.UsageError("--view is computed on this machine: it takes no cluster option")
-    api.check_engine(engine)
+    check_engine(engine)
     if watch and several:
         raise click.UsageError("--watch renders one scene file")
     if watch and (sequence or skip_existing):
@@ -287,6 +287,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     import numpy as np
 
     from rtcli import api, runs
+    from rtcli.api.pictures import check_ids, legend
     from rtcli.core.display import signature_colors
     from rtcli.rendering.writer import write_images
     where = _cluster(cluster, cluster_file, local_cluster)
@@ -297,14 +298,14 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     if where is None:
         ids = api.signature(scene, width=width, height=height, block_size=block_size, workers=workers)
     else:
-        api.check_ids(scene)
+        check_ids(scene)
         with where:
             ids = runs.on_cluster(loaded, scene, where, dict(samples=None, max_depth=None), width, height, block_size,
                               signature=True)
     write_images([(out, signature_colors(ids))] + ([(ids_out, np.asarray(ids))] if ids_out else []))
     if legend:
         click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
-        for row in api.legend(scene, ids):
+        for row in legend(scene, ids):
             click.echo(f"{row.id:>5}  {one_line(row.name) or '-':<24} {row.shape:<10} {row.pixels:>9}")
 
 
@@ -327,7 +328,7 @@ def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_sam
     """Explain why pixel (X, Y) has its color: its ray tree, every term of the shading equation
     with its numbers, and the sum at every ray (X from the left, Y from the top, from 0)."""
     from rtcli import runs
-    from rtcli.inspect.explain import explain as explain_pixel
+    from rtcli.api import explain as explain_pixel
     if sample is not None and all_samples:
         raise click.UsageError("--sample and --all-samples go one at a time")
     _, scene = _load(scene_file, frame)
@@ -432,10 +433,10 @@ def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
 def validate(scene_file, list_objects, strict):
     """Parse and check a scene, every frame of an animated one; print a summary, and warnings about
     likely mistakes on stderr. Renders only a small signature (does the camera see anything?)."""
+    from rtcli.api.loading import load_file
     from rtcli.inspect import checks, lint
-    from rtcli.rendering.frames import load
     from rtcli.scenefile.build import summary
-    loaded = load(scene_file, lint=True)
+    loaded = load_file(scene_file, lint=True)
     frames = loaded.animation.check_all()
     scene, found = loaded.scene, loaded.warnings
     if strict and found:
@@ -458,7 +459,7 @@ def warmup(cluster, cluster_file, local_cluster):
 
     where = _cluster(cluster, cluster_file, local_cluster)
     if where is not None:
-        from rtcli.cluster_engine import warm
+        from rtcli.cluster.warm import warm
         with where:
             return warm(where.session(), click.echo)
     from rtcli import machinecode, variants

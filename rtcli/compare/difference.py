@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rtcli.api.results import ImageArray, png_bytes
 from rtcli.compare import images as gate
 from rtcli.errors import RtcliError
-from rtcli.results import ImageArray, png_bytes
 
 GATE = {"tolerance": 2, "max_bad_pixels": 16, "max_bad_fraction": 1e-4, "max_cluster": 3}
 ID_GATE = {"max_boundary_mismatch": 8, "max_boundary_fraction": 0.01}

@@ -1,6 +1,6 @@
 """Why a pixel has its color: the ray tree of one pixel, term by term (docs/debugging.md).
 
-`explain` traces the pixel's rays with the numpy engine (rtcli/wavefront/trace.py) and a
+`explain_pixel` traces the pixel's rays with the numpy engine (rtcli/wavefront/trace.py) and a
 Recorder, which the engine shows every quantity as it computes it: the hit, the surface, the
 ambient term, each light sample's feeler and terms, Fresnel's R and Snell's indices, each
 secondary ray's weight and color. The numbers in the tree are therefore the render's own, and
@@ -19,14 +19,16 @@ import math
 
 import numpy as np
 
+from rtcli.core.display import to_8bit
+from rtcli.core.jitter import sample_positions
 from rtcli.core.lights import COLOR, POSITION, attenuation, spot_factor
 from rtcli.core.scene import Scene
 from rtcli.errors import RtcliError
 from rtcli.inspect.raytree import Explanation, Feeler, Glass, Hit, LightSample, LightTerm, RayNode
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
-from rtcli.wavefront.rays import Rays
-from rtcli.wavefront.trace import Log
+from rtcli.wavefront.rays import Rays, camera_rays
+from rtcli.wavefront.trace import Log, trace
 
 
 class Recorder(Log):
@@ -118,8 +120,6 @@ def coefficients(table, m: int) -> dict:
 
 def trace_one(scene: Scene, x: float, y: float, width: int, height: int) -> RayNode:
     """The tree of the primary ray through image position (x, y) of a width x height image."""
-    from rtcli.wavefront.rays import camera_rays
-    from rtcli.wavefront.trace import trace
     rays = camera_rays(scene.camera(width, height), np.array([x]), np.array([y]), width, height)
     root = RayNode("primary", 1, rays.o[:, 0], rays.d[:, 0])
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
@@ -127,42 +127,26 @@ def trace_one(scene: Scene, x: float, y: float, width: int, height: int) -> RayN
     return root
 
 
-def explain(scene, x: int, y: int, *, width: int | None = None, height: int | None = None,
-            samples: int | None = None, max_depth: int | None = None, gamma: bool = False,
-            bvh: bool = True) -> Explanation:
-    """The ray trees of pixel (x, y) (column from the left, row from the top) of a Scene, or of
-    what rtcli.load_scene takes; the size and settings as `rtcli.render` takes them."""
-    from rtcli import api, wavefront
-    from rtcli.core.display import to_8bit
-    from rtcli.core.jitter import sample_positions
-    from rtcli.scene_api import Scene as Loaded
-    from rtcli.scene_api import check_options
-    check_options(width=width, height=height, samples=samples, max_depth=max_depth)
-    if not isinstance(scene, Loaded):
-        scene = api.load_scene(scene, width=width, height=height)
-    model = scene.model
-    w, h = _size(scene, width, height)
-    for name, value, size in (("x", x, w), ("y", y, h)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise RtcliError(f"the pixel's {name} must be a whole number, got {value!r}")
-    if not (0 <= x < w and 0 <= y < h):
-        raise RtcliError(f"pixel ({x}, {y}) is outside the {w}x{h} image: x goes from 0 to {w - 1}, "
-                         f"y from 0 to {h - 1}")
+def explain_pixel(model, x: int, y: int, width: int, height: int, gamma: bool = False) -> Explanation:
+    """The ray trees of pixel (x, y) of a width x height image of a scene model readied for the numpy
+    engine, with its own samples and max_depth: one tree per sample, and the pixel their mean."""
     settings = model.settings
-    with settings.overridden(samples, max_depth):
-        wavefront.prepare(model, bvh)
-        n = settings.samples
-        xs, ys = sample_positions(np.array([x]), np.array([y]), n)
-        trees = [trace_one(model, float(xs[k, 0]), float(ys[k, 0]), w, h) for k in range(n * n)]
+    n = settings.samples
+    xs, ys = sample_positions(np.array([x]), np.array([y]), n)
+    trees = [trace_one(model, float(xs[k, 0]), float(ys[k, 0]), width, height) for k in range(n * n)]
     value = np.array([t.value for t in trees]).reshape(n * n, 1, 3).mean(axis=0)     # as render_tile averages
-    return Explanation(int(x), int(y), w, h, n, np.column_stack([xs[:, 0], ys[:, 0]]), trees, value[0],
+    return Explanation(int(x), int(y), width, height, n, np.column_stack([xs[:, 0], ys[:, 0]]), trees, value[0],
                        to_8bit(value, gamma)[0], np.asarray(model.background, float), settings.specular, gamma)
 
 
-def _size(scene, width, height) -> tuple[int, int]:
-    from rtcli.scene_api import image_size
-    w, h, _ = image_size(scene.model, width, height)
-    return w, h
+def check_pixel(x, y, width: int, height: int) -> None:
+    """RtcliError unless (x, y) is a pixel of a width x height image (whole numbers, from 0)."""
+    for name, value in (("x", x), ("y", y)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise RtcliError(f"the pixel's {name} must be a whole number, got {value!r}")
+    if not (0 <= x < width and 0 <= y < height):
+        raise RtcliError(f"pixel ({x}, {y}) is outside the {width}x{height} image: x goes from 0 to {width - 1}, "
+                         f"y from 0 to {height - 1}")
 
 
-__all__ = ["explain", "Explanation", "RayNode", "Hit", "LightTerm", "LightSample", "Feeler", "Glass"]
+__all__ = ["explain_pixel", "check_pixel", "Explanation", "RayNode", "Hit", "LightTerm", "LightSample", "Feeler", "Glass"]
