@@ -241,6 +241,17 @@ def test_a_file_anyone_else_could_have_written_is_never_opened(place, planted, n
     assert len(notes) == 1 and said in notes[0], notes
 
 
+def test_without_memory_files_a_private_copy_is_opened_and_removed(small, monkeypatch, tmp_path_factory):
+    """Where there is no memfd (macOS), the checked bytes are opened from a copy in a new 0700
+    folder, removed once open."""
+    monkeypatch.delattr(os, "memfd_create")
+    private = tmp_path_factory.mktemp("tmp")
+    monkeypatch.setattr(machinecode.tempfile, "tempdir", str(private))
+    kept = len(machinecode._kept)
+    assert machinecode.load("small")(*small_args()) == (4, 4)
+    assert len(machinecode._kept) == kept and list(private.iterdir()) == []
+
+
 def test_a_folder_that_is_a_link_to_this_users_folder_is_followed(small, place, tmp_path_factory):
     """The cache folder may be reached through a link (NUMBA_CACHE_DIR often is one): what is
     checked is the folder it leads to."""
