@@ -217,6 +217,9 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
     if keep_going and (watch or sequence):
         raise click.UsageError("--keep-going renders the other scenes when one is broken: it takes no --watch, "
                                "--frames, frame pattern or movie")
+    if stats:                       # why a machine code file is not used, if one is not
+        from rtcli import machinecode
+        machinecode.report_to(runs.note)
     where = _cluster(cluster, cluster_file, local_cluster)
     bar = not quiet and (progress or sys.stderr.isatty())
     lint = runs.lint(quiet, strict, several, watch)
@@ -466,6 +469,7 @@ def warmup(cluster, cluster_file, local_cluster):
     from rtcli.compiled.warmup import bytecode
     from rtcli.compiled.warmup import warmup as warm
     start = time.perf_counter()
+    machinecode.report_to(lambda text: click.echo(f"note: {text}", err=True))
     where = variants.cache_location() if variants.ENABLED else None
     if where is not None:
         click.echo(f"cache: {where} ({where.why})" if where.enabled else f"cache: none ({where.why}); "
