@@ -27,9 +27,10 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from rtcli import runs, variants
+from rtcli import variants
 from rtcli.api.loading import load_file
 from rtcli.cli import main
+from rtcli.cli import terminal as runs
 from rtcli.cluster import renders, software, tasks
 from rtcli.cluster import session as sessions
 from rtcli.cluster.target import Target
