@@ -31,8 +31,9 @@ from rtcli.scenefile import yamlfile
 from rtcli.scenefile.build import build_scene
 from rtcli.scenefile.files import reading_scene
 from rtcli.scenefile.nodes import MapNode, SeqNode
-from rtcli.scenefile.params import Params, describe, finite_numbers, out_of_range
+from rtcli.scenefile.params import Params
 from rtcli.scenefile.reuse import Parts, sharing
+from rtcli.scenefile.values import describe, finite_numbers, out_of_range
 
 MAX_FRAMES = 100_000
 EASES = {                                   # s in [0, 1] between two keys -> the share of the way

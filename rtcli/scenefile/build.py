@@ -22,7 +22,8 @@ from rtcli.scenefile import remarks, yamlfile
 from rtcli.scenefile.files import reading_scene
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
 from rtcli.scenefile.objects import ObjectBuilder, material_from, transform_from
-from rtcli.scenefile.params import Params, as_params, describe
+from rtcli.scenefile.params import Params, as_params
+from rtcli.scenefile.values import describe
 
 
 def load_scene(path: str) -> Scene:

@@ -25,8 +25,10 @@ from rtcli.scenefile.files import open_image
 from rtcli.scenefile.guards import bounded, check_count, scale_factors
 from rtcli.scenefile.limits import MAX_MESH_BYTES
 from rtcli.scenefile.obj import read_obj
-from rtcli.scenefile.params import MATERIAL_KEYS, Params, as_params, describe
+from rtcli.scenefile.hints import MATERIAL_KEYS
+from rtcli.scenefile.params import Params, as_params
 from rtcli.scenefile.presets import PRESETS
+from rtcli.scenefile.values import describe
 from rtcli.scenefile.yamlfile import MapNode
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import REQUIRED, ParamError
