@@ -21,8 +21,10 @@ from rtcli.errors import SceneError, plural
 from rtcli.scenefile import remarks, yamlfile
 from rtcli.scenefile.files import reading_scene
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
-from rtcli.scenefile.objects import ObjectBuilder, material_from, transform_from
+from rtcli.scenefile.materials import material_from
+from rtcli.scenefile.objects import ObjectBuilder
 from rtcli.scenefile.params import Params, as_params
+from rtcli.scenefile.transforms import transform_from
 from rtcli.scenefile.values import describe
 
 
