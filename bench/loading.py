@@ -48,15 +48,15 @@ def phases(repeat: int) -> None:
 
     from rtcli import variants
     from rtcli.core import bvh_build
-    from rtcli.scenefile import build, yamlfile
+    from rtcli.scenefile import load, yamlfile
     from rtcli.scenefile.obj import read_obj
     from rtcli.shapes.mesh import Mesh
 
     spheres, torus = os.path.join(HERE, "spheres1k.yaml"), os.path.join(HERE, "torus100k.obj")
     docs = lambda: yamlfile.load(spheres)                                      # noqa: E731
     rows = [("spheres1k: YAML tree", cpu(docs, repeat)),
-            ("spheres1k: scene from the tree", cpu(lambda: build.scene_from_docs(docs()), repeat) - cpu(docs, repeat)),
-            ("spheres1k: load_scene", cpu(lambda: build.load_scene(spheres), repeat))]
+            ("spheres1k: scene from the tree", cpu(lambda: load.scene_from_docs(docs()), repeat) - cpu(docs, repeat)),
+            ("spheres1k: load_scene", cpu(lambda: load.load_scene(spheres), repeat))]
     obj = read_obj(torus)
     mesh = Mesh.from_values(obj)
     lo, hi = mesh._boxes

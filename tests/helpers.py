@@ -14,7 +14,7 @@ import numpy as np
 
 from rtcli.rendering.tiles import Job, render_tile
 from rtcli.scenefile import yamlfile
-from rtcli.scenefile.build import scene_from_docs
+from rtcli.scenefile.load import scene_from_docs
 
 # exact-value tests of shading: a tolerance, two light directions, a material that shows only its
 # specular or mirror term, and numbers written into YAML to the last digit

@@ -14,8 +14,9 @@ import pytest
 
 from rtcli.errors import SceneError
 from rtcli.scenefile import yamlfile
-from rtcli.scenefile.animation import EASES, Animation, load_animation
-from rtcli.scenefile.build import load_scene
+from rtcli.scenefile.animation import Animation
+from rtcli.scenefile.keyframes import EASES
+from rtcli.scenefile.load import load_animation, load_scene
 
 SCENE = """\
 image: {width: 16, height: 12}

@@ -18,7 +18,7 @@ from rtcli import compiled as fast
 from rtcli import variants
 from rtcli.errors import RtcliError
 from rtcli.rendering.tiles import Job, render, render_tile
-from rtcli.scenefile.build import load_scene
+from rtcli.scenefile.load import load_scene
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 
@@ -346,7 +346,7 @@ def test_corner_normals_that_cancel_fall_back_to_the_face(yaml_scene):
 def test_loading_the_engine_skips_numbas_blas_lookup_and_leaves_no_trace():
     import subprocess
     import sys
-    code = ("import sys; from rtcli.scenefile.build import load_scene; from rtcli import compiled as fast; "
+    code = ("import sys; from rtcli.scenefile.load import load_scene; from rtcli import compiled as fast; "
             "fast.choose(load_scene('scenes/whitted.yaml'), 'compiled'); "
             "print('scipy.linalg' in sys.modules, 'scipy.linalg.cython_blas' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
@@ -464,7 +464,7 @@ def test_numpys_two_code_paths_and_both_engines_give_the_same_bytes(tmp_path):
     numpy engine in a process whose numpy has no AVX-512 paths (SVML), and here by both engines."""
     (tmp_path / "random.yaml").write_text(random_csg_scene(11, SOLIDS))
     paths = [str(ROOT / "scenes" / f"{name}.yaml") for name in CPU_SENSITIVE] + [str(tmp_path / "random.yaml")]
-    code = ("import sys, numpy as np; from rtcli.rendering.tiles import Job, render; from rtcli.scenefile.build import "
+    code = ("import sys, numpy as np; from rtcli.rendering.tiles import Job, render; from rtcli.scenefile.load import "
             "load_scene; from rtcli.core.display import to_8bit; "
             "[np.save(f'{sys.argv[1]}/{k}.npy', to_8bit(render(load_scene(p), Job(80, 60, engine='numpy'))[0], "
             "gamma=True)) for k, p in enumerate(sys.argv[2:])]")

@@ -19,7 +19,7 @@ from rtcli.compare import images as compare
 from rtcli.core.display import signature_colors
 from rtcli.rendering.tiles import Job, render
 from rtcli.rendering.writer import write_png
-from rtcli.scenefile.build import load_scene
+from rtcli.scenefile.load import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = sorted(p for p in (ROOT / "scenes").glob("*.yaml"))

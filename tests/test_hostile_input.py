@@ -16,7 +16,7 @@ from PIL import Image
 
 from rtcli.errors import SceneError
 from rtcli.scenefile import guards, yamlfile
-from rtcli.scenefile.build import scene_from_docs
+from rtcli.scenefile.load import scene_from_docs
 
 CAM = "camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}\nimage: {width: 8, height: 6}\n"
 

@@ -19,7 +19,7 @@ from rtcli import compiled as fast
 from rtcli import machinecode, variants
 from rtcli.core import bvh_build
 from rtcli.rendering.tiles import Job, render_tile
-from rtcli.scenefile.build import load_scene
+from rtcli.scenefile.load import load_scene
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 

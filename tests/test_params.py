@@ -10,6 +10,7 @@ import pytest
 
 from rtcli.errors import SceneError
 from rtcli.scenefile import params as P
+from rtcli.scenefile.values import finite_numbers
 from rtcli.scenefile.yamlfile import parse
 
 VALUES = [0, 1, 0.5, -0.0, -1, -0.5, 1e20, 1e21, -1e20, 10**30, True, False, "x", None, math.nan, math.inf, 2, 1.0]
@@ -66,7 +67,7 @@ def test_quick_vectors_agree_with_the_checked_path():
     for triple in TRIPLES:
         node = node_of(triple)
         x = node["k"]
-        slow = checked(lambda: P.finite_numbers(x, node.value_where["k"], "m.k", 3, "a vector"))
+        slow = checked(lambda: finite_numbers(x, node.value_where["k"], "m.k", 3, "a vector"))
         assert P._plain_numbers(x) == (not isinstance(slow, str)), triple
         if P._plain_numbers(x):
             np.testing.assert_array_equal(P.Params(node, "m").numbers_value("k", x, 3), slow)

@@ -20,7 +20,7 @@ from PIL import Image
 from scipy import ndimage
 
 from rtcli.rendering.tiles import Job, render
-from rtcli.scenefile.build import load_scene
+from rtcli.scenefile.load import load_scene
 
 DATA = Path(__file__).resolve().parent / "data" / "povray"
 W, H = 160, 120

@@ -267,7 +267,7 @@ def test_after_warmup_no_scene_compiles_anything(warm, monkeypatch):
     from rtcli.compiled import query
     from rtcli.compiled.integrator import trace_camera
     from rtcli.rendering.tiles import Job, render
-    from rtcli.scenefile.build import load_scene
+    from rtcli.scenefile.load import load_scene
     scenes = [load_scene(str(p)) for p in sorted((ROOT / "scenes").glob("*.yaml")) +
               sorted((ROOT / "bench").glob("*.yaml"))]
     for scene in scenes:

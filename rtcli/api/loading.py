@@ -15,9 +15,10 @@ from rtcli.errors import RtcliError
 from rtcli.inspect import checks
 from rtcli.inspect.lint import warn
 from rtcli.scenefile import yamlfile
-from rtcli.scenefile.animation import Animation, load_animation
+from rtcli.scenefile.animation import Animation
 from rtcli.scenefile.files import collecting, reading_scene
 from rtcli.scenefile.limits import MAX_SCENE_BYTES
+from rtcli.scenefile.load import load_animation
 from rtcli.scenefile.plain import DICT, tree_from_dict
 from rtcli.scenefile.remarks import recording_remarks
 

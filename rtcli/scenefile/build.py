@@ -1,7 +1,9 @@
-"""Scene file -> Scene: the top level, the camera, lights and settings (docs/scene-format.md).
+"""Scene tree -> Scene: the top level, the camera, lights and settings (docs/scene-format.md).
 
 Only the modules of rtcli/scenefile/ know YAML keys. Every key is read through
-Params, so unknown keys are reported with file:line:col.
+Params, so unknown keys are reported with file:line:col. The documents built here
+hold plain values only: an animated scene's frame comes here with its keyframes
+resolved (animation.py), and load.py reads a scene file, still or animated.
 """
 
 from __future__ import annotations
@@ -18,24 +20,13 @@ from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
 from rtcli.core.vec import unit3
 from rtcli.errors import SceneError, plural
-from rtcli.scenefile import remarks, yamlfile
-from rtcli.scenefile.files import reading_scene
+from rtcli.scenefile import remarks
 from rtcli.scenefile.limits import MAX_PIXELS, MAX_SIDE
-from rtcli.scenefile.objects import ObjectBuilder, material_from, transform_from
-from rtcli.scenefile.params import Params, as_params, describe
-
-
-def load_scene(path: str) -> Scene:
-    """Read, check and build the scene at `path` (with its includes)."""
-    return load_scene_and_inputs(path)[0]
-
-
-def load_scene_and_inputs(path: str) -> tuple[Scene, list[str]]:
-    """The scene, and the real paths of every file it read (scene, includes, meshes, textures),
-    read with the garbage collector paused (files.reading_scene)."""
-    with reading_scene() as inputs:
-        scene = scene_from_docs(yamlfile.load(path))
-    return scene, inputs
+from rtcli.scenefile.materials import material_from
+from rtcli.scenefile.objects import ObjectBuilder
+from rtcli.scenefile.params import Params, as_params
+from rtcli.scenefile.transforms import transform_from
+from rtcli.scenefile.values import describe
 
 
 def check_image_size(width: int, height: int) -> str | None:
@@ -50,15 +41,6 @@ def camera_form(scene: Scene) -> str:
     """'fov', 'window' or 'screen': which of the three camera forms the scene uses."""
     forms = {cameras.from_fov: "fov", cameras.from_window: "window", cameras.from_screen: "screen"}
     return forms.get(getattr(scene.camera, "func", None), "fov")
-
-
-def scene_from_docs(docs: list) -> Scene:
-    """Included documents first, the main file last; only the main file sets camera and image.
-    An animated scene (an `animation:` section) gives its first frame."""
-    if "animation" in docs[-1]:
-        from rtcli.scenefile.animation import Animation
-        return Animation(docs).scene(1)
-    return build_scene(docs)
 
 
 def build_scene(docs: list) -> Scene:

@@ -3,80 +3,24 @@
 Every getter checks the type, reports errors as `file:line:col: key.path: message`,
 and remembers the key as read; `check_unused()` then reports the first key
 nobody read, which catches typos such as `raduis:`. An unknown key's message
-lists the keys allowed in its mapping, suggests the closest one, and translates
-the lecture notes' names (`kd`, `wl`, `exponent`, ...) into rtcli's. A required key
-that is missing while a misspelling of it is given is reported at the misspelling.
+lists the keys allowed in its mapping and a hint (hints.py); a required key that
+is missing while a misspelling of it is given is reported at the misspelling. What
+a value may be, and how a wrong one is shown, is values.py's (docs/scene-format.md,
+Values).
 """
 
 from __future__ import annotations
 
-import difflib
-import math
-
 import numpy as np
 
-from rtcli.errors import SceneError, Where, quoted, shown
-from rtcli.scenefile.limits import MAX_MAGNITUDE, RANGE
-from rtcli.scenefile.nodes import CommentedColor
+from rtcli.errors import SceneError, Where, shown
+from rtcli.scenefile.hints import NOTES_NAMES, misspells, unknown_key_hint
+from rtcli.scenefile.limits import MAX_MAGNITUDE
+from rtcli.scenefile.nodes import MapNode, SeqNode
 from rtcli.scenefile.remarks import note_color
-from rtcli.scenefile.yamlfile import MapNode, SeqNode
+from rtcli.scenefile.values import channel_problem, describe, finite_numbers, is_number, out_of_range
 
 REQUIRED = object()
-
-# The lecture notes' names for what rtcli calls otherwise (docs/scene-format.md, "The notes'
-# names"): a hint when one is given where rtcli's name is allowed.
-NOTES_NAMES = {
-    "wl": "left", "wr": "right", "wt": "top", "wb": "bottom",              # the window (notes 000, 11.2)
-    "f": "focal", "position": "eye", "lookat": "look_at",                   # the camera
-    "ka": "ambient", "kd": "diffuse", "ks": "specular", "kr": "reflection", "kt": "transmission",
-    "exponent": "shininess", "n": "shininess", "color": "diffuse",          # a material (notes 002, 004)
-    "angle": "degrees",                                                     # a rotate step
-}
-MATERIAL_KEYS = ("ambient", "diffuse", "specular", "shininess", "emission", "reflection", "transmission",
-                 "ior", "shadow", "fresnel", "texture", "preset")
-
-
-def _is_number(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
-
-
-def out_of_range(x) -> str | None:
-    """Why the number x is refused (not finite, or beyond +-MAX_MAGNITUDE), or None.
-
-    The limit keeps squares and higher powers of lengths finite (docs/scene-format.md,
-    "Limits"); a huge integer is judged without converting it to a float.
-    """
-    if isinstance(x, int):
-        if abs(x) <= MAX_MAGNITUDE:
-            return None
-        digits = len(str(abs(x))) if x.bit_length() < 10000 else int(x.bit_length() * 0.30103) + 1
-        return f"must be {RANGE}, got an integer of {digits} digits"
-    if not math.isfinite(x):
-        return f"must be a finite number {RANGE}, got {x}"
-    if abs(x) > MAX_MAGNITUDE:
-        return f"must be {RANGE}, got {x:g}"
-    return None
-
-
-def describe(x) -> str:
-    """How a wrong value is shown in a message."""
-    if isinstance(x, MapNode):
-        return "keyframes, which only the values listed under Animation in docs/scene-format.md take, " \
-               "in a scene with an `animation:` section" if "keys" in x else "a mapping"
-    if isinstance(x, SeqNode):
-        return f"a list of {len(x)}"
-    if isinstance(x, str):
-        return quoted(x)
-    if x is None:
-        return "nothing"
-    if isinstance(x, CommentedColor):
-        return (f"nothing (YAML reads the unquoted {x.text} as a comment: write it in quotes, "
-                f"\"{x.text}\")")
-    if isinstance(x, bool):
-        return str(x).lower()
-    if isinstance(x, int) and x.bit_length() > 64:
-        return f"an integer of about {int(x.bit_length() * 0.30103) + 1} digits"
-    return quoted(x) if not isinstance(x, (int, float)) else repr(x)
 
 
 class Params:
@@ -131,7 +75,7 @@ class Params:
         if key not in self.node:
             if default is REQUIRED:
                 for given in self.node:
-                    if given not in self.read and _misspells(given, key):
+                    if given not in self.read and misspells(given, key):
                         raise self.unknown_key(given, key)
                 for given in self.node:                  # the notes' name of another key declared here
                     if given not in self.read and isinstance(given, str) and NOTES_NAMES.get(given) in self.read:
@@ -162,7 +106,7 @@ class Params:
         return float(x)
 
     def _check_number(self, key, x, positive=False, non_negative=False, what="a number"):
-        if not _is_number(x):
+        if not is_number(x):
             raise self.error(key, f"must be {what}, got {describe(x)}")
         if (why := out_of_range(x)) is not None:
             raise self.error(key, why)
@@ -255,12 +199,12 @@ class Params:
                     pass
             raise SceneError(where, label, f"must be a color [r, g, b] or \"#rrggbb\", got {describe(x)}")
         written = x
-        if allow_scalar and _is_number(x):
+        if allow_scalar and is_number(x):
             x = [x, x, x]
         if not isinstance(x, list) or len(x) != 3:
             raise SceneError(where, label, f"must be a color [r, g, b] or \"#rrggbb\", got {describe(x)}")
         for k, v in enumerate(x):
-            if (why := _channel_problem(v, at_most)) is not None:
+            if (why := channel_problem(v, at_most)) is not None:
                 item_where = x.item_where[k] if isinstance(x, SeqNode) else where
                 raise SceneError(item_where, f"{label}[{k}]", why)
         note_color(written, where, label)
@@ -270,7 +214,7 @@ class Params:
         """A color or one number k meaning [k, k, k]; each at most `at_most` when given."""
         x = self.raw(key, default)
         if x is default and default is not REQUIRED:
-            return np.full(3, float(x)) if _is_number(x) else np.broadcast_to(np.array(x, dtype=float), (3,)).copy()
+            return np.full(3, float(x)) if is_number(x) else np.broadcast_to(np.array(x, dtype=float), (3,)).copy()
         plain = _plain_channels(x, True, at_most)
         if plain is not None:
             return plain
@@ -296,31 +240,6 @@ class Params:
         return [(v, x.item_where[k], f"{self.key_path(key)}[{k}]") for k, v in enumerate(x)]
 
 
-def _misspells(given, key: str) -> bool:
-    """Whether the key `given` looks like `key` misspelled, abbreviated or in the notes' words."""
-    if not isinstance(given, str):
-        return False
-    return (NOTES_NAMES.get(given) == key or bool(difflib.get_close_matches(key, [given], n=1))
-            or (len(given) >= 3 and key.startswith(given)))
-
-
-def unknown_key_hint(key, allowed: list, meant: str | None = None) -> str:
-    """' (...)': the lecture notes' name of an allowed key, the allowed key `key` seems to
-    misspell (`meant`, or the closest), or, for a material's key given to an object, that it
-    belongs in the material; '' when none fits."""
-    notes = NOTES_NAMES.get(key) if isinstance(key, str) else None
-    if notes in allowed:
-        return f" (the notes' {shown(key)} is {quoted(notes)} in rtcli)"
-    close = [meant] if meant else difflib.get_close_matches(str(key), allowed, n=1) or \
-        [a for a in allowed if len(str(key)) >= 3 and a.startswith(str(key))][:1]
-    if close:
-        return f" (did you mean {quoted(close[0])}?)"
-    if "material" in allowed and (notes or key) in MATERIAL_KEYS:
-        said = f"the notes' {shown(key)} is {quoted(notes)} in rtcli, a key" if notes else f"{shown(key)} is a key"
-        return f" ({said} of the object's material: material: {{{notes or key}: ...}})"
-    return ""
-
-
 def _plain_numbers(x) -> bool:
     """Whether every item of x is an int or a float within +-MAX_MAGNITUDE (what finite_numbers
     accepts), checked without building a label or a location."""
@@ -332,7 +251,7 @@ def _plain_numbers(x) -> bool:
 
 def _plain_channels(x, allow_scalar: bool, at_most) -> np.ndarray | None:
     """The color of a list of three numbers (or of one number k meaning [k, k, k]) each of
-    which _channel_problem accepts, at once; None for anything else, which color_value reads
+    which channel_problem accepts, at once; None for anything else, which color_value reads
     (and names what is wrong): the common case without building a label or a location.
     Channels above 1 also go the careful way, which notes colors that look like 0-255 values."""
     top = 1.0 if at_most is None else min(at_most, 1.0)
@@ -343,29 +262,6 @@ def _plain_channels(x, allow_scalar: bool, at_most) -> np.ndarray | None:
     for v in x:
         if not (type(v) is float or type(v) is int) or not 0 <= v <= top:
             return None
-    return np.array(x, dtype=float)
-
-
-def _channel_problem(v, at_most=None) -> str | None:
-    """Why v is refused as a channel of a color or coefficient, or None."""
-    if not _is_number(v) or (isinstance(v, float) and not math.isfinite(v)) or v < 0:
-        return f"must be a finite number >= 0, got {describe(v)}"
-    if (why := out_of_range(v)) is not None:
-        return why
-    if at_most is not None and v > at_most:
-        return f"must be at most {at_most:g}, got {v:g}"
-    return None
-
-
-def finite_numbers(x, where: Where, label: str, count: int, what: str) -> np.ndarray:
-    """x as an array if it is a list of exactly `count` numbers within +-MAX_MAGNITUDE, else a located error."""
-    if not isinstance(x, list) or len(x) != count:
-        raise SceneError(where, label, f"must be {what}, got {describe(x)}")
-    for k, v in enumerate(x):
-        if not _is_number(v) or out_of_range(v) is not None:
-            item_where = x.item_where[k] if isinstance(x, SeqNode) else where
-            why = out_of_range(v) if _is_number(v) else f"must be a finite number, got {describe(v)}"
-            raise SceneError(item_where, f"{label}[{k}]", why)
     return np.array(x, dtype=float)
 
 

@@ -5,7 +5,7 @@ no node graph: each value is built as its events arrive, without recursion.
 Mappings and lists nest at most MAX_DEPTH deep; aliases, each counted as a copy
 of what it names, repeat at most ALIAS_BUDGET values; an alias may not name a
 collection that contains it; merge keys (`<<`) merge as PyYAML's flatten_mapping
-does, without copying (docs/scene-format.md, "Limits").
+does, without copying (yamlmerge.py; docs/scene-format.md, "Limits").
 """
 
 from __future__ import annotations
@@ -19,12 +19,12 @@ import yaml
 from rtcli.errors import SceneError, Where, quoted, shown
 from rtcli.scenefile.limits import ALIAS_BUDGET, MAX_DEPTH, RANGE
 from rtcli.scenefile.nodes import CommentedColor, MapNode, SeqNode, pack, size_of, unpack
+from rtcli.scenefile.yamlmerge import MERGE, fill_map
 
 _TAG = "tag:yaml.org,2002:"
 _SCALAR_TAGS = {_TAG + t for t in ("null", "bool", "int", "float", "str", "binary", "timestamp")}
 _PLAIN_FLOAT = re.compile(r"-?[0-9]+\.[0-9]*\Z")      # read as a float by every YAML 1.1 rule too
 _PLAIN_INT = re.compile(r"-?[1-9][0-9]{0,17}\Z|0\Z")
-_MERGE = object()               # the value of a `<<` key
 _HEX_COMMENT = re.compile(r"[ \t]*(#[0-9a-fA-F]{6})\b")     # an unquoted color, read as a comment
 
 
@@ -47,7 +47,7 @@ _RESOLVED = frozenset(Loader.yaml_implicit_resolvers) if None not in Loader.yaml
 class _Frame:
     """A mapping or list being read. A mapping's entries go straight into its node while
     they are plain (no merge key, no key twice); from the first that is not, the
-    (key, value) pairs are kept instead, and fill_map orders them when it ends."""
+    (key, value) pairs are kept instead, and yamlmerge.fill_map orders them when it ends."""
 
     __slots__ = ("node", "anchor", "pairs", "key", "key_pos", "places", "size")
 
@@ -116,12 +116,7 @@ class Builder:
                     else:
                         value = self.scalar(event)
             elif kind is yaml.MappingStartEvent or kind is yaml.SequenceStartEvent:
-                if event.tag is None and event.anchor is None and len(stack) < MAX_DEPTH:
-                    mark = event.start_mark
-                    stack.append(_Frame(MapNode() if kind is yaml.MappingStartEvent else SeqNode(), None,
-                                        (mark.line + 1) << 32 | (mark.column + 1)))
-                else:
-                    stack.append(self.start(event, len(stack)))
+                stack.append(self.start(event, len(stack)))
                 continue
             elif kind is yaml.AliasEvent:
                 value, pos = self.alias(event), pack(event.start_mark)
@@ -138,7 +133,7 @@ class Builder:
                 frame.size += value.size if type(value) is MapNode or type(value) is SeqNode else 1
             elif frame.key is None:
                 frame.key, frame.key_pos = (value if type(value) is str else self.key(value, pos)), pos
-            elif frame.pairs is None and frame.key is not _MERGE and frame.key not in node:
+            elif frame.pairs is None and frame.key is not MERGE and frame.key not in node:
                 node[frame.key] = value
                 places = frame.places
                 places.append(frame.key_pos)
@@ -149,6 +144,7 @@ class Builder:
                 self.add(frame, value, pos)
 
     def start(self, event, depth: int) -> _Frame:
+        """The frame of a mapping or list that starts at `event`, inside `depth` others."""
         if depth >= MAX_DEPTH:
             raise SceneError(self.where(event.start_mark), "", f"values nest more than {MAX_DEPTH} deep")
         if event.tag not in (None, "!", _TAG + "map", _TAG + "seq"):
@@ -177,7 +173,7 @@ class Builder:
         if tag == _TAG + "str":
             value = sys.intern(text) if len(text) <= 64 else text
         elif tag == _TAG + "merge":
-            value = _MERGE
+            value = MERGE
         elif tag == _TAG + "null" and not text and event.implicit[0]:
             value = self.commented_color(event.start_mark)
         elif tag in _SCALAR_TAGS:
@@ -253,7 +249,7 @@ class Builder:
             frame.key = None
 
     def key(self, value, pos: int):
-        if value is _MERGE:
+        if value is MERGE:
             return value
         if not isinstance(value, (str, int, float, bool)):
             raise SceneError(unpack(self.file, pos), "", "keys must be plain names")
@@ -269,46 +265,10 @@ class Builder:
             if frame.pairs is None:
                 node.places, node.duplicates = frame.places, ()
             else:
-                self.fill_map(node, frame)
+                fill_map(node, frame.pairs, frame.places, self.file)
         else:
             node.places = frame.places
         if frame.anchor is not None:
             self.open.discard(frame.anchor)
             self.anchors[frame.anchor] = (node, node.where)
         return node
-
-    def fill_map(self, node: MapNode, frame: _Frame) -> None:
-        """Merged entries first (as PyYAML's flatten_mapping orders them), then the written ones, which win."""
-        places, merged, written, first, duplicates = frame.places, [], [], {}, []
-        for key, key_pos, value, value_pos in frame.pairs:
-            if key is _MERGE:
-                merged.extend(self.merge_entries(value, value_pos))
-                continue
-            if key in first:
-                duplicates.append((key, unpack(self.file, key_pos), unpack(self.file, first[key])))
-            first.setdefault(key, key_pos)
-            written.append((key, key_pos, value, value_pos))
-        slot = {}                                               # key -> its index in places
-        for key, key_pos, value, value_pos in merged + written:
-            if key in slot:
-                k = slot[key]
-                node.size -= size_of(node[key])
-                places[k], places[k + 1] = key_pos, value_pos
-            else:
-                slot[key] = len(places)
-                places.extend((key_pos, value_pos))
-            node[key] = value
-            node.size += size_of(value)
-        node.places, node.duplicates = places, tuple(duplicates)
-
-    def merge_entries(self, value, value_pos) -> list:
-        """(key, key_pos, value, value_pos) of the mappings a `<<` key names, the first listed winning."""
-        sources = [value] if isinstance(value, MapNode) else value
-        if not isinstance(sources, list) or not all(isinstance(s, MapNode) for s in sources):
-            raise SceneError(unpack(self.file, value_pos), "", "invalid YAML: a merge key (<<) takes a mapping "
-                             "or a list of mappings")
-        entries = []
-        for source in reversed(sources):
-            for k, key in enumerate(source):
-                entries.append((key, source.places[1 + 2 * k], source[key], source.places[2 + 2 * k]))
-        return entries
