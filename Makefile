@@ -13,9 +13,9 @@ $(BASE): pyproject.toml
 	$(PY) -m pip install --quiet -e .
 	touch $(BASE)
 
-# Everything the tests use: numba (the compiled engine), FLIP, Dask, the test tools.
+# Everything the tests use: numba (the compiled engine), FLIP, Dask, the preview's server, the test tools.
 $(FULL): $(BASE)
-	$(PY) -m pip install --quiet -e '.[test,fast,flip,cluster]'
+	$(PY) -m pip install --quiet -e '.[test,fast,flip,cluster,preview]'
 	touch $(FULL)
 
 # The first image at once, with the numpy engine: no numba to install or compile.

@@ -1,4 +1,5 @@
-"""The rtcli command line (README.md, Commands): render, signature, explain, compare, validate, presets, warmup.
+"""The rtcli command line (README.md, Commands): render, signature, explain, compare, validate, preview,
+presets, warmup.
 
 Argument handling only. Errors from the library (RtcliError) and usage errors
 become one `error: ...` line on stderr with exit code 2; `--debug` shows the
@@ -477,6 +478,39 @@ def warmup(cluster, cluster_file, local_cluster):
         click.echo("note: rtcli's folder is read-only: its Python files were not compiled to bytecode", err=True)
     compiled = sum(load.compile_seconds for _, load in done)
     click.echo(f"{'compiled' if compiled else 'warm: nothing to compile'}; {time.perf_counter() - start:.2f} s in all")
+
+
+@main.command()
+@click.argument("scene_file", metavar="SCENE.yaml")
+@click.option("--port", type=click.IntRange(0, 65535), default=0, show_default=True,
+              help="The port to serve on (0: any free one).")
+@click.option("--host", default="127.0.0.1", show_default=True, callback=_not_empty,
+              help="The address to serve on; another than 127.0.0.1 is warned about.")
+@click.option("--no-browser", is_flag=True, help="Print the URL only; do not open a browser.")
+@click.option("--width", type=SIZE, help="Image width (the camera is kept).")
+@click.option("--height", type=SIZE, help="Image height (the camera is kept).")
+@click.option("--samples", type=click.IntRange(1, 16), help="N x N samples per pixel.")
+@click.option("--max-depth", type=click.IntRange(1, 64), help="Rays per path, the primary included.")
+@click.option("--engine", type=click.Choice(["auto", "numpy", "compiled"]), default="auto", show_default=True,
+              help="As for render.")
+@click.option("--gamma", is_flag=True, help="sRGB-encode the picture (default: linear).")
+@click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects.")
+@click.option("--frame", type=click.IntRange(1), default=1, metavar="N", help="Start at frame N of an animated scene.")
+@click.option("--against", metavar="GOLDEN.png", callback=_not_empty,
+              help="Compare each finished render with this image: heat map, slider, FLIP where installed.")
+@click.option("--tev", metavar="HOST:PORT", callback=_not_empty,
+              help="Also stream the tiles and views to the tev viewer listening there (its default: 127.0.0.1:14158).")
+def preview(scene_file, port, host, no_browser, width, height, samples, max_depth, engine, gamma, no_bvh, frame,
+            against, tev):
+    """Serve a live preview of SCENE.yaml in the browser: it renders coarse to fine, renders again at
+    every save of the scene or a file it reads, and explains the pixel clicked. Ctrl-C ends it
+    (docs/preview.md)."""
+    from rtcli import api, runs
+    from rtcli.preview import Options, serve
+    api.check_engine(engine)
+    options = Options(width, height, samples, max_depth, engine, gamma, not no_bvh, frame)
+    serve(scene_file, options, host=host, port=port, browser=not no_browser, against=against, tev=tev,
+          url=lambda text: click.echo(text), say=runs.stamped)
 
 
 @main.command()

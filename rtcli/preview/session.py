@@ -1,0 +1,277 @@
+"""The scene a preview shows: loaded, rendered pass by pass, watched, and asked about.
+
+One thread owns the scene (the model, its engine, its BVH are not shared): it loads the
+scene file as `rtcli render --watch` does (watch.py: the stamps of every file read, meshes
+kept from one load to the next), renders it pass by pass (passes.py), and between two tiles
+answers what the pages ask (a pixel's explanation, a debug view, another frame) and looks
+at the files. A save stops the render after the tile at hand and starts the next one; a
+broken edit publishes its one-line error and keeps the last good picture.
+
+What it publishes (messages.py) goes through `publish`, which the server hands to every
+page; `snapshot()` is what a page that arrives late is sent first.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import os
+import queue
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from rtcli.errors import RtcliError, error_line, one_line, shown
+from rtcli.preview import messages
+from rtcli.preview.passes import Progressive
+from rtcli.views import KINDS as VIEWS
+from rtcli.watch import Changes, recording
+
+POLL = 0.05                        # seconds between looks at the scene's files
+PENDING = 16                       # questions waiting for the thread at most; more are refused (Busy)
+
+
+class Busy(RtcliError):
+    """Too many questions wait already."""
+
+
+@dataclass(frozen=True)
+class Options:
+    """The render options of `rtcli preview` (as `rtcli render` takes them)."""
+
+    width: int | None = None
+    height: int | None = None
+    samples: int | None = None
+    max_depth: int | None = None
+    engine: str = "auto"
+    gamma: bool = False
+    bvh: bool = True
+    frame: int = 1
+
+
+class Session:
+    """A scene file previewed: run() is the thread's body, until stop()."""
+
+    def __init__(self, path: str, options: Options, publish: Callable, say: Callable[[str], None],
+                 golden=None, tev=None):
+        self.path, self.options, self.publish, self.say = path, options, publish, say
+        self.golden, self.tev = golden, tev          # against.Golden, tev.Tev (or None)
+        self.frame = options.frame
+        self.requests: queue.Queue = queue.Queue(PENDING)
+        self.render = 0                              # the number of the render in hand
+        self.scene = self.base = None                # scene_api.Scene of the frame shown, and of frame 1
+        self.image = self.ids = None
+        self.info = self.error = self.progress = self.done = self.compare = None
+        self.warnings: list[str] = []                # the scene's warnings, as `rtcli render` prints them
+        self.views: dict = {}                        # a render's debug views, by kind, as they are asked for
+        self._kept, self._changes, self._next_poll = None, None, 0.0
+        self._reload, self._rerender, self._stopping = True, False, threading.Event()
+
+    # --- what the server calls, from its thread ---
+
+    def ask(self, what: str, *args) -> concurrent.futures.Future:
+        """A question for the thread (explain, view, frame), answered between two tiles."""
+        future = concurrent.futures.Future()
+        try:
+            self.requests.put_nowait((what, args, future))
+        except queue.Full:
+            raise Busy("busy: too many questions wait; ask again") from None
+        return future
+
+    def snapshot(self) -> list:
+        """What a page is sent when it arrives: the scene, the picture as it is, the id map, how
+        far the render is, its error."""
+        out = [m for m in (self.info, self.progress, self.done, self.compare) if m is not None]
+        if self.image is not None:
+            out.append(messages.image_message(self.render, self.image))
+        if self.ids is not None:
+            out.append(messages.ids_message(self.render, self.ids))
+        return out + [{"type": "error", "line": self.error}]
+
+    def stop(self) -> None:
+        self._stopping.set()
+
+    # --- the thread ---
+
+    def run(self) -> None:
+        from rtcli.scenefile.reuse import Kept
+        self._kept = Kept()
+        while not self._stopping.is_set():
+            try:
+                if self._reload:
+                    self._load()
+                if self._rerender:
+                    self._render()
+                else:
+                    self._attend(POLL)
+            except Exception as e:         # noqa: BLE001 -- a bug: said on the page, and the next save tries again
+                self._rerender = False
+                self._failed(RtcliError(f"rtcli preview failed ({type(e).__name__}: {e}); this is a bug in rtcli"))
+
+    def _load(self) -> None:
+        """Load the scene file, recording what it reads; publish the error of a broken one."""
+        from rtcli.frames import load
+        from rtcli.lint import lines
+        from rtcli.scene_api import of_loaded
+        self._reload = False
+        o = self.options
+        with recording(self.path, self._kept) as seen:
+            try:
+                loaded = load(self.path, None, lint=True)
+                base = of_loaded(loaded, self.path).override(o.width, o.height, o.samples, o.max_depth)
+                self.frame = min(self.frame, base.frames)
+                scene = base.at(self.frame)
+            except (RtcliError, MemoryError) as e:
+                self._failed(e)
+                scene = None
+        self._changes = Changes(seen)
+        if scene is not None:
+            self.base, self.scene, self._rerender = base, scene, True
+            self.warnings = lines(loaded.warnings, self.path, base.frames)
+            for line in self.warnings:
+                self.say(line)
+
+    def _failed(self, e: BaseException) -> None:
+        self.error = error_line(e)
+        self.say(self.error)
+        self.publish({"type": "error", "line": self.error})
+
+    def _render(self) -> None:
+        """Render the scene in hand pass by pass; return early when a file changes, another frame
+        is asked for, or the preview stops."""
+        from rtcli.render import Job
+        self._rerender, o, scene = False, self.options, self.scene
+        self.render += 1
+        self.views, self.done, self.compare, self.progress = {}, None, None, None
+        job = Job(scene.width, scene.height, gamma=o.gamma, engine=o.engine, bvh=o.bvh)
+        try:
+            run = Progressive(scene.model, job, notes=lambda text: self.say(f"note: {text}"))
+        except (RtcliError, MemoryError) as e:
+            return self._failed(e)
+        self.info = self._scene_info(scene)
+        self.publish(self.info)
+        if self.tev is not None:
+            self.tev.begin(self._title(), scene.width, scene.height)
+        for tile in run.tiles():
+            self._show(run, tile)
+            if tile.last and tile.block == run.blocks[0]:
+                self.image = run.image                # a page arriving now sees the first pass, not black
+                self._signature()
+            if self._interrupted():
+                return
+        self._finish(run)
+
+    def _interrupted(self) -> bool:
+        """Answer the questions waiting; whether the render in hand is to stop."""
+        self._attend(0)
+        return self._reload or self._rerender or self._stopping.is_set()
+
+    def _show(self, run: Progressive, tile) -> None:
+        if self.error is not None:
+            self.error = None
+            self.publish({"type": "error", "line": None})
+        self.publish(messages.tile_message(self.render, tile.block, tile.rows, tile.cols, tile.pixels))
+        p = run.progress
+        self.progress = {"type": "progress", "render": self.render, "block": tile.block, "last": tile.last,
+                         "traced": p.traced, "pixels": p.pixels, "seconds": p.seconds, "eta": p.eta}
+        self.publish(self.progress)
+        if self.tev is not None:
+            self.tev.tile(tile)
+
+    def _signature(self) -> None:
+        """The id map of the scene in hand (hover and outline on the page)."""
+        from rtcli.api import signature
+        self.ids = np.asarray(signature(self.scene, workers=1))
+        self.publish(messages.ids_message(self.render, self.ids))
+
+    def _finish(self, run: Progressive) -> None:
+        """The render is done: its stats, the golden comparison, tev's channels."""
+        from rtcli.results import RenderStats
+        s, scene = run.stats, self.scene
+        stats = RenderStats.of(scene.width, scene.height, scene.model.settings.samples, s, run.progress.seconds)
+        self.done = {"type": "done", "render": self.render, "seconds": run.progress.seconds, "stats": stats.line()}
+        self.publish(self.done)
+        self.say(f"rendered {self._title()} ({scene.width}x{scene.height}) in {run.progress.seconds:.2f} s")
+        if self.golden is not None:
+            self.compare = self.golden.compare(self.render, self.image)
+            self.publish(self.compare)
+        if self.tev is not None:
+            self.tev.image(run.linear)
+            for kind in VIEWS:
+                if self._interrupted():
+                    return
+                self.tev.view(kind, self._view(kind)[0])
+
+    def _title(self) -> str:
+        name = os.path.basename(self.path)
+        return name if self.base.frames == 1 else f"{name} frame {self.frame}"
+
+    def _scene_info(self, scene) -> dict:
+        from rtcli.checks import object_rows
+        return {"type": "scene", "render": self.render, "name": shown(self.path), "title": self._title(),
+                "width": scene.width, "height": scene.height, "frame": self.frame, "frames": self.base.frames,
+                "samples": scene.model.settings.samples, "warnings": self.warnings,
+                "against": self.golden.about() if self.golden is not None else None,
+                "objects": [{"id": r.id, "name": one_line(r.name), "shape": r.shape, "material": one_line(r.material)}
+                            for r in object_rows(scene.model)]}
+
+    # --- questions, and the watch, between two tiles ---
+
+    def _attend(self, timeout: float) -> None:
+        """Answer the questions waiting (waiting up to `timeout` for one), and look at the files
+        when a poll is due."""
+        try:
+            self._answer(*(self.requests.get(timeout=timeout) if timeout else self.requests.get_nowait()))
+            while True:
+                self._answer(*self.requests.get_nowait())
+        except queue.Empty:
+            pass
+        now = time.monotonic()
+        if self._changes is not None and now >= self._next_poll:
+            self._next_poll = now + POLL
+            if self._changes.poll():
+                self._reload = True
+
+    def _answer(self, what: str, args: tuple, future: concurrent.futures.Future) -> None:
+        if not future.set_running_or_notify_cancel():
+            return
+        try:
+            future.set_result(getattr(self, f"_{what}")(*args))
+        except (RtcliError, MemoryError) as e:
+            future.set_exception(RtcliError(one_line(str(e) or "out of memory")))
+        except Exception as e:             # noqa: BLE001 -- a bug: the page says so, and the preview goes on
+            future.set_exception(RtcliError(f"{type(e).__name__}: {e} (a bug in rtcli)"))
+
+    def _explain(self, x: int, y: int) -> tuple[str, str]:
+        """Pixel (x, y) of the frame shown explained: `rtcli explain --json`'s text, and its tree as
+        `rtcli explain` prints it (explain.py)."""
+        from rtcli.explain import explain
+        if self.scene is None:
+            raise RtcliError("the scene has not loaded: nothing to explain")
+        e = explain(self.scene, x, y, gamma=self.options.gamma, bvh=self.options.bvh)
+        return e.json(), e.text(0)
+
+    def _view(self, kind: str) -> tuple[np.ndarray, str, bytes]:
+        """(data, summary, PNG) of the debug view `kind` of the frame shown (views.py)."""
+        from rtcli import views
+        from rtcli.results import png_bytes
+        if self.scene is None:
+            raise RtcliError("the scene has not loaded: no view to show")
+        if kind not in VIEWS:
+            raise RtcliError(f"the view must be one of {', '.join(VIEWS)}, got {one_line(kind)!r}")
+        if kind not in self.views:
+            max_depth = self.scene.model.settings.max_depth
+            data = self.ids if kind == "ids" and self.ids is not None else np.asarray(views.view(self.scene, kind))
+            self.views[kind] = (data, views.summary(data, kind, max_depth),
+                                png_bytes(views.picture(data, kind, max_depth)))
+        return self.views[kind]
+
+    def _frame(self, k: int) -> int:
+        """Show frame k (a page's frame slider); the frame shown."""
+        if self.base is None or not 1 <= k <= self.base.frames:
+            raise RtcliError(f"frame {k}: the scene has {self.base.frames if self.base else 0} frames")
+        if k != self.frame:
+            self.frame, self.scene, self._rerender = k, self.base.at(k), True
+        return self.frame
