@@ -83,7 +83,7 @@ async def _serve(scene, options, host, port, browser, golden, tev, url, say) -> 
 async def _listen(runner, host: str, port: int) -> int:
     """Listen on host:port (port 0: any free one); the port. A busy port is an RtcliError."""
     from aiohttp import web
-    site = web.TCPSite(runner, host, port)
+    site = web.TCPSite(runner, host, port, shutdown_timeout=1)
     try:
         await site.start()
     except OSError as e:

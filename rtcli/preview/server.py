@@ -21,7 +21,7 @@ import hmac
 import json
 from importlib import resources
 
-from aiohttp import WSMsgType, web
+from aiohttp import WSCloseCode, WSMsgType, web
 
 from rtcli.errors import RtcliError, one_line
 from rtcli.preview.session import Busy, Session
@@ -102,7 +102,13 @@ class Preview:
         app.router.add_get("/view/{kind}.json", self.view)
         app.router.add_get("/image.png", self.image)
         app.router.add_get("/against/{which}.png", self.against)
+        app.on_shutdown.append(self.close_pages)
         return app
+
+    async def close_pages(self, app) -> None:
+        """Close every page's websocket, so that the server ends at once (the pages say so)."""
+        for page in list(self.pages):
+            await page.ws.close(code=WSCloseCode.GOING_AWAY, message=b"rtcli preview ended")
 
     @web.middleware
     async def guard(self, request: web.Request, handler):

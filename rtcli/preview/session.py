@@ -83,12 +83,11 @@ class Session:
     def snapshot(self) -> list:
         """What a page is sent when it arrives: the scene, the picture as it is, the id map, how
         far the render is, its error."""
-        out = [m for m in (self.info, self.progress, self.done, self.compare) if m is not None]
-        if self.image is not None:
-            out.append(messages.image_message(self.render, self.image))
-        if self.ids is not None:
-            out.append(messages.ids_message(self.render, self.ids))
-        return out + [{"type": "error", "line": self.error}]
+        image, ids = self.image, self.ids
+        pictures = [messages.image_message(self.render, image) if image is not None else None,
+                    messages.ids_message(self.render, ids) if ids is not None else None]
+        out = [self.info, *pictures, self.progress, self.done, self.compare, {"type": "error", "line": self.error}]
+        return [m for m in out if m is not None]
 
     def stop(self) -> None:
         self._stopping.set()

@@ -293,8 +293,8 @@
   }
 
   // --- the ray tree: every number of `rtcli explain --json`, each tagged with its path there ---
-  function val(path, v) {
-    const text = Array.isArray(v) ? vec(v) : typeof v === "number" ? num(v) : String(v);
+  function val(path, v, shown) {
+    const text = shown !== undefined ? shown : Array.isArray(v) ? vec(v) : typeof v === "number" ? num(v) : String(v);
     return el("span", { class: "n", "data-path": path, "data-value": JSON.stringify(v) }, text);
   }
 
@@ -306,8 +306,8 @@
     const head = $("explain-head");
     head.replaceChildren("pixel ", val("pixel", e.pixel), " of ", val("image", e.image), " = ",
       val("value", e.value), " → 8-bit ", val("byte", e.byte), e.gamma ? " (sRGB)" : "",
-      e.samples_per_pixel > 1 ? el("span", { class: "note" }, " the mean of ",
-        val("samples_per_pixel", e.samples_per_pixel), " samples") : "");
+      el("span", { class: "note" }, e.samples_per_pixel > 1 ? " the mean of " : " ",
+        val("samples_per_pixel", e.samples_per_pixel), e.samples_per_pixel > 1 ? " samples" : " sample"));
     const samples = $("samples");
     samples.hidden = e.samples.length < 2;
     samples.replaceChildren(...e.samples.map((s, i) => {
@@ -340,7 +340,6 @@
     d.append(row(el("span", { class: "sum" }, "local "), val(`${p}.local`, node.local)));
     if (node.glass) d.append(glassRow(node.glass, `${p}.glass`));
     if (node.stopped) d.append(row(el("span", { class: "note" }, `max_depth ${node.depth} reached: no reflected or refracted ray`)));
-    d.append(row("stopped ", val(`${p}.stopped`, node.stopped)));
     node.children.forEach((child, i) => d.append(rayNode(child, `${p}.children.${i}`, true)));
     d.append(row(el("span", { class: "sum" }, "= "), val(`${p}.total`, node.total),
       el("span", { class: "label" }, "  (the engine returned "), val(`${p}.value`, node.value), el("span", { class: "label" }, ")")));
@@ -353,7 +352,7 @@
     return [
       row("hits #", val(`${p}.object`, h.object), " ", val(`${p}.name`, h.name || "(unnamed)"), " (",
         val(`${p}.shape`, h.shape), ") at t = ", val(`${p}.t`, h.t), ", point ", val(`${p}.point`, h.point), ", ",
-        val(`${p}.entering`, h.entering), h.entering ? " (entering)" : " (leaving, from inside)"),
+        val(`${p}.entering`, h.entering, h.entering ? "entering" : "leaving (from inside)")),
       row("normal N ", val(`${p}.normal`, h.normal), ", geometric ", val(`${p}.geometric`, h.geometric)),
       row("material ", val(`${p}.material_name`, h.material_name), " (#", val(`${p}.material`, h.material), "):",
         ...["ka", "kd", "ks", "n", "emission", "kr", "kt", "ior", "fresnel", "shadow"].flatMap(coefficient),
@@ -401,8 +400,7 @@
       : [", refraction θt ", val(`${p}.theta_t`, g.theta_t), " deg"];
     return row("glass: n1 ", val(`${p}.n1`, g.n1), " → n2 ", val(`${p}.n2`, g.n2), ", cos θi ", val(`${p}.cos_i`, g.cos_i),
       ", incidence θi ", val(`${p}.theta_i`, g.theta_i), " deg", ...refraction, ", Fresnel R ", val(`${p}.R`, g.R),
-      ", tir ", val(`${p}.tir`, g.tir), ", fresnel ", val(`${p}.fresnel`, g.fresnel),
-      el("span", { class: "note" }, g.fresnel ? " (weights kr R and kt (1 - R))" : " (weights kr and kt as given)"));
+      el("span", { class: "note" }, g.fresnel ? " (the weights: kr R and kt (1 - R))" : " (the weights: kr and kt as given; fresnel: false)"));
   }
 
   // --- the controls ---
