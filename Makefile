@@ -22,6 +22,7 @@ $(FULL): $(BASE)
 demo: $(BASE)
 	$(VENV)/bin/rtcli render scenes/whitted.yaml -o whitted.png --stats
 	@echo "wrote whitted.png. Next: make warmup (numba's compiled engine, several times faster on big images; it compiles once)"
+	@echo "Live in the browser: $(PY) -m pip install -e '.[preview]', then $(VENV)/bin/rtcli preview scenes/whitted.yaml"
 
 # Compile the compiled engine once (numba caches it), so no render waits for it; it says how far it has got.
 warmup: $(FULL)

@@ -61,7 +61,8 @@ async def _serve(scene, options, host, port, browser, golden, tev, url, say) -> 
     loop, token = asyncio.get_running_loop(), secrets.token_urlsafe(24)
     session = Session(scene, options, lambda message: _post(loop, preview.publish, message), say, golden, tev)
     preview = Preview(session, token, set(), "", golden)
-    runner = web.AppRunner(preview.app(), access_log=None, handle_signals=False, keepalive_timeout=60)
+    runner = web.AppRunner(preview.app(), access_log=None, handle_signals=False, keepalive_timeout=60,
+                           shutdown_timeout=1)
     await runner.setup()
     try:
         bound = await _listen(runner, host, port)
@@ -83,7 +84,7 @@ async def _serve(scene, options, host, port, browser, golden, tev, url, say) -> 
 async def _listen(runner, host: str, port: int) -> int:
     """Listen on host:port (port 0: any free one); the port. A busy port is an RtcliError."""
     from aiohttp import web
-    site = web.TCPSite(runner, host, port, shutdown_timeout=1)
+    site = web.TCPSite(runner, host, port)
     try:
         await site.start()
     except OSError as e:

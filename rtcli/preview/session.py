@@ -189,7 +189,8 @@ class Session:
         """The render is done: its stats, the golden comparison, tev's channels."""
         from rtcli.results import RenderStats
         s, scene = run.stats, self.scene
-        stats = RenderStats.of(scene.width, scene.height, scene.model.settings.samples, s, run.progress.seconds)
+        stats = RenderStats.of(scene.width, scene.height, scene.model.settings.samples, s, run.progress.seconds,
+                               start_up=False)
         self.done = {"type": "done", "render": self.render, "seconds": run.progress.seconds, "stats": stats.line()}
         self.publish(self.done)
         self.say(f"rendered {self._title()} ({scene.width}x{scene.height}) in {run.progress.seconds:.2f} s")

@@ -91,6 +91,8 @@
   }
 
   function mark(render, block) {
+    const last = state.marks[state.marks.length - 1];
+    if (last && last.render === render && last.block === block) return;     // the same picture, told twice
     state.marks.push({ render, block, at: performance.now(), wall: Date.now() });
     document.body.dataset.pictures = String(state.marks.length);
   }
@@ -179,12 +181,12 @@
     state.view = view;
     for (const b of document.querySelectorAll("[data-view]")) b.setAttribute("aria-pressed", String(b.dataset.view === view));
     const picture = $("picture"), golden = $("golden"), split = $("split"), summary = $("summary");
-    picture.hidden = golden.hidden = split.hidden = true;
+    picture.hidden = golden.hidden = split.hidden = $("seam").hidden = true;
     summary.textContent = "";
     if (view === "image") return;
     if (view === "slider") {
       golden.src = url("against/golden.png");
-      golden.hidden = split.hidden = false;
+      golden.hidden = split.hidden = $("seam").hidden = false;
       clip();
       summary.textContent = state.comparison ? `golden: ${state.comparison.summary}` : "golden: the render is not done";
       return;
@@ -210,6 +212,7 @@
 
   function clip() {                         // the slider: the render on the left, the golden image on the right
     $("golden").style.clipPath = `inset(0 0 0 ${$("split").value}%)`;
+    $("seam").style.marginLeft = `calc(${$("split").value}% - 1px)`;
   }
 
   async function answer(response) {
@@ -362,7 +365,7 @@
   }
 
   function lightBlock(light, p) {
-    const d = el("details", { class: "light", open: light.samples.length === 1 },
+    const d = el("details", { class: "light" },
       el("summary", {}, `light ${light.index} (${light.kind}): diffuse + specular `,
         vec(light.samples.reduce((s, x) => s.map((v, i) => v + x.diffuse[i] + x.specular[i]), [0, 0, 0]))));
     d.append(row("light ", val(`${p}.index`, light.index), " ", val(`${p}.kind`, light.kind), " at ",
