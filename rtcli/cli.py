@@ -495,20 +495,22 @@ def warmup(cluster, cluster_file, local_cluster):
               help="As for render.")
 @click.option("--gamma", is_flag=True, help="sRGB-encode the picture (default: linear).")
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects.")
+@click.option("--workers", type=click.IntRange(1, 256), help="Threads tracing tiles with the compiled engine "
+                                                             "(default: all cores).")
 @click.option("--frame", type=click.IntRange(1), default=1, metavar="N", help="Start at frame N of an animated scene.")
 @click.option("--against", metavar="GOLDEN.png", callback=_not_empty,
               help="Compare each finished render with this image: heat map, slider, FLIP where installed.")
 @click.option("--tev", metavar="HOST:PORT", callback=_not_empty,
               help="Also stream the tiles and views to the tev viewer listening there (its default: 127.0.0.1:14158).")
-def preview(scene_file, port, host, no_browser, width, height, samples, max_depth, engine, gamma, no_bvh, frame,
-            against, tev):
+def preview(scene_file, port, host, no_browser, width, height, samples, max_depth, engine, gamma, no_bvh, workers,
+            frame, against, tev):
     """Serve a live preview of SCENE.yaml in the browser: it renders coarse to fine, renders again at
     every save of the scene or a file it reads, and explains the pixel clicked. Ctrl-C ends it
     (docs/preview.md)."""
     from rtcli import api, runs
     from rtcli.preview import Options, serve
     api.check_engine(engine)
-    options = Options(width, height, samples, max_depth, engine, gamma, not no_bvh, frame)
+    options = Options(width, height, samples, max_depth, engine, gamma, not no_bvh, frame, workers)
     serve(scene_file, options, host=host, port=port, browser=not no_browser, against=against, tev=tev,
           url=lambda text: click.echo(text), say=runs.stamped)
 

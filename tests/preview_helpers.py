@@ -47,7 +47,8 @@ LOOK = """\
 materials:
   floor: {ambient: 0.1, diffuse: 0.8, specular: 0, texture: {checker: {colors: [[0.95, 0.9, 0.15], [0.9, 0.1, 0.1]]}}}
   paint: {ambient: 0.1, diffuse: %s, specular: 0.5, shininess: 40, reflection: 0.3}
-  glass: {ambient: 0, diffuse: 0.004, specular: 0.9, shininess: 80, reflection: 0.1, transmission: 0.92, ior: 1.5, shadow: false}
+  glass: {ambient: 0, diffuse: 0.004, specular: 0.9, shininess: 80, reflection: 0.1, transmission: 0.92, ior: 1.5,
+          shadow: false}
 """
 RED, GREEN = "[0.8, 0.1, 0.1]", "[0.1, 0.8, 0.1]"
 

@@ -5,6 +5,7 @@ assertion is about time."""
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import io
 import json
 import os
@@ -20,7 +21,7 @@ from PIL import Image
 from preview_helpers import GREEN, LOOK, Page, Preview, read_page, save, write_scene
 
 import rtcli
-from rtcli import views
+from rtcli import variants, views
 from rtcli.cli import main
 from rtcli.preview import server
 from rtcli.preview.against import flip_installed
@@ -48,6 +49,23 @@ def test_each_pass_is_the_block_size_preview_and_the_last_the_render(tmp_path, s
     assert run.progress.traced == 70 * 52 and run.stats.primary == 70 * 52 * samples ** 2   # each pixel once
 
 
+@pytest.mark.skipif(not variants.ENABLED, reason="needs numba (the compiled engine)")
+def test_the_compiled_engine_traces_the_tiles_in_threads_to_the_same_bytes(tmp_path):
+    scene = rtcli.load_scene(write_scene(tmp_path), width=80, samples=2)
+    run = Progressive(scene.model, Job(scene.width, scene.height, engine="compiled"), threads=3)
+    tiles = list(run.tiles())
+    assert run.threads == 3 and run.stats.engine == "compiled"
+    assert [t.block for t in tiles if t.last] == [16, 8, 4, 2, 1]
+    np.testing.assert_array_equal(run.image, rtcli.render(scene, engine="numpy", workers=1))
+    np.testing.assert_array_equal(run.linear, rtcli.render(scene, linear=True, engine="numpy", workers=1))
+    stopped = Progressive(scene.model, Job(scene.width, scene.height, engine="compiled"), threads=3)
+    with contextlib.closing(stopped.tiles()) as some:
+        for tile in some:
+            if tile.block == 4:
+                break                                            # a save: the render stops within the pass
+    assert 0 < stopped.progress.traced < 80 * 60
+
+
 def test_a_small_image_has_no_pass_of_blocks_as_big_as_itself():
     assert passes(16, 9) == [8, 4, 2, 1] and passes(1, 1) == [1]
 
@@ -55,8 +73,8 @@ def test_a_small_image_has_no_pass_of_blocks_as_big_as_itself():
 def test_changes_are_taken_once_they_hold_still(tmp_path):
     path = tmp_path / "a.yaml"
     path.write_text("one")
-    from rtcli.watch import recording
     from rtcli.scenefile.reuse import Kept
+    from rtcli.watch import recording
     with recording(str(path), Kept()) as seen:
         pass
     changes = Changes(seen)
@@ -156,7 +174,8 @@ def test_preview_serves_the_render_explains_it_and_streams_it_to_tev(tmp_path):
         assert http(preview, "", token="wrong")[0] == 403
         assert http(preview, "static/preview.js", token=None)[0] == 401
         status, headers, body = http(preview, "")
-        assert status == 200 and b"preview.js" in body and "frame-ancestors 'none'" in headers["Content-Security-Policy"]
+        assert status == 200 and b"preview.js" in body
+        assert "frame-ancestors 'none'" in headers["Content-Security-Policy"]
         cookie = headers["Set-Cookie"].split(";")[0]
         assert "HttpOnly" in headers["Set-Cookie"] and "SameSite=Strict" in headers["Set-Cookie"]
         assert http(preview, "static/preview.js", token=None, cookie=cookie)[0] == 200
@@ -361,8 +380,8 @@ def test_another_host_than_127_0_0_1_is_warned_about(tmp_path):
     preview = Preview(tmp_path, "--host", "127.0.0.2")
     try:
         assert preview.host == "127.0.0.2"
-        preview.wait_for(lambda: "warning: --host 127.0.0.2: the preview is served beyond 127.0.0.1" in preview.stderr(),
-                         "the warning")
+        warning = "warning: --host 127.0.0.2: the preview is served beyond 127.0.0.1"
+        preview.wait_for(lambda: warning in preview.stderr(), "the warning")
         assert http(preview, "")[0] == 200
     finally:
         assert preview.stop()[0] == 130

@@ -121,7 +121,8 @@ def test_a_user_s_session_in_the_browser(tmp_path, browser, monkeypatch):
         assert page.get_attribute("body", "data-outlined") == "2"
         outline = page.evaluate("""() => { const o = document.getElementById('overlay');
             const d = o.getContext('2d').getImageData(0, 0, o.width, o.height).data; let n = 0;
-            for (let i = 0; i < d.length; i += 4) n += d[i] === 0 && d[i + 1] === 229 && d[i + 2] === 255; return n; }""")
+            for (let i = 0; i < d.length; i += 4) n += d[i] === 0 && d[i + 1] === 229 && d[i + 2] === 255;
+            return n; }""")
         edge = (ids == 2) & ~(np.pad(ids == 2, 1)[:-2, 1:-1] & np.pad(ids == 2, 1)[2:, 1:-1]
                              & np.pad(ids == 2, 1)[1:-1, :-2] & np.pad(ids == 2, 1)[1:-1, 2:])
         assert outline == int(edge.sum()) - 1 or outline == int(edge.sum())    # less the clicked pixel's cross

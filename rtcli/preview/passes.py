@@ -10,13 +10,16 @@ render), and after pass B the image is, byte for byte, the one `--block-size B` 
 The passes are cut into tiles of about TILE_RAYS rays (render.py's tiles are bigger: here a
 tile is what a new edit waits for before the render stops), each traced by render.py's
 render_tile with the engine render.prepare picked, and handed on as soon as it is done.
+The compiled engine traces a pass's tiles in several threads at once (Progressive).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import threading
 import time
 from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,9 +88,14 @@ def new_points(rows: np.ndarray, cols: np.ndarray, block: int, first: bool) -> n
 
 class Progressive:
     """One render of a scene's model, pass by pass: tiles() traces them; `image` (8-bit) and
-    `linear` (float) hold the picture so far, each pixel the color of the block it is in."""
+    `linear` (float) hold the picture so far, each pixel the color of the block it is in.
 
-    def __init__(self, model, job: Job, notes: Callable[[str], None] | None = None):
+    With the compiled engine, `threads` threads trace a pass's tiles at once, each with a twin
+    of the engine (Compiled.twin); the numpy engine traces in the caller's thread. Either way
+    the tiles are placed in the caller's thread, as they come, and a pass begins once the last
+    is done (its grid points' colors are the next pass's old points)."""
+
+    def __init__(self, model, job: Job, notes: Callable[[str], None] | None = None, threads: int = 1):
         self.model, self.job = model, job
         self.blocks = passes(job.width, job.height)
         self.image = blank(job)
@@ -98,31 +106,67 @@ class Progressive:
         self.stats.engine = "compiled" if self.engine else "numpy"
         if load:
             self.stats.load_seconds, self.stats.compile_seconds = load.seconds, load.compile_seconds
+        self.threads = threads if self.engine else 1
 
     def tiles(self) -> Iterator[Tile]:
-        """Trace the passes tile by tile, each tile placed in the image before it is yielded; stop
-        early by not asking for the next one."""
+        """Trace the passes tile by tile, each tile placed in the image before it is yielded. Stop
+        early by closing the generator: the tiles in flight are waited for, the rest not begun."""
         start, samples = time.perf_counter(), self.model.settings.samples
-        for k, block in enumerate(self.blocks):
-            self.progress.block = block
-            todo = list(grid_tiles(self.job.width, self.job.height, block, samples))
-            for n, (rows, cols) in enumerate(todo, 1):
-                tile = self._trace(block, rows, cols, k == 0, n == len(todo))
-                self.progress.seconds = time.perf_counter() - start
-                yield tile
+        pool = self._pool() if self.threads > 1 else None
+        try:
+            for k, block in enumerate(self.blocks):
+                self.progress.block = block
+                todo = [(rows, cols, new_points(rows, cols, block, k == 0))
+                        for rows, cols in grid_tiles(self.job.width, self.job.height, block, samples)]
+                for n, (rows, cols, new, traced) in enumerate(self._traced(pool, todo), 1):
+                    tile = self._place(block, rows, cols, new, traced, n == len(todo))
+                    self.progress.seconds = time.perf_counter() - start
+                    yield tile
+        finally:
+            if pool is not None:
+                pool.shutdown(wait=True, cancel_futures=True)
 
-    def _trace(self, block: int, rows: np.ndarray, cols: np.ndarray, first: bool, last: bool) -> Tile:
-        """Trace the tile's new points; the tile's grid with the points traced before, placed."""
-        new = new_points(rows, cols, block, first)
+    def _pool(self) -> ThreadPoolExecutor:
+        own = threading.local()
+
+        def twin() -> None:
+            own.engine = self.engine.twin()
+        self._own = own
+        return ThreadPoolExecutor(self.threads, "rtcli-tile", initializer=twin)
+
+    def _traced(self, pool, todo: list):
+        """(rows, cols, new, (colors, stats)) of each tile, its new points traced: in order here,
+        or as the pool's threads finish them."""
+        if pool is None:
+            for rows, cols, new in todo:
+                yield rows, cols, new, self._trace(self.engine, rows, cols, new)
+            return
+        futures = {pool.submit(lambda *a: self._trace(self._own.engine, *a), rows, cols, new): (rows, cols, new)
+                   for rows, cols, new in todo}
+        try:
+            for done in as_completed(futures):
+                yield (*futures[done], done.result())
+        finally:
+            for future in futures:
+                future.cancel()
+
+    def _trace(self, engine, rows: np.ndarray, cols: np.ndarray, new: np.ndarray):
+        """The linear colors (n, 3) of the tile's new points, and the stats of tracing them."""
         jj, ii = (a[new] for a in np.meshgrid(rows, cols, indexing="ij"))
-        colors = self.linear[rows][:, cols]                     # the points traced before keep theirs
-        pixels = self.image[rows][:, cols]
-        if len(ii):
-            traced, stats = render_tile(self.model, self.job, ii, jj, self.engine)
-            colors[new], pixels[new] = traced, to_8bit(traced, self.job.gamma)
-            self.stats.add(stats)
-            self.progress.traced += len(ii)
+        if not len(ii):
+            return np.zeros((0, 3)), Stats()
+        return render_tile(self.model, self.job, ii, jj, engine)
+
+    def _place(self, block: int, rows, cols, new, traced, last: bool) -> Tile:
+        """Place a tile's grid, its new points' colors with the old points' (traced before), over
+        their blocks; the Tile."""
+        colors, stats = traced
+        grid_colors = self.linear[rows][:, cols]
+        grid_pixels = self.image[rows][:, cols]
+        grid_colors[new], grid_pixels[new] = colors, to_8bit(colors, self.job.gamma)
+        self.stats.add(stats)
+        self.progress.traced += len(colors)
         job = dataclasses.replace(self.job, block_size=block)
-        place(self.image, job, rows, cols, pixels)
-        place(self.linear, job, rows, cols, colors)
-        return Tile(block, rows, cols, pixels, colors, last)
+        place(self.image, job, rows, cols, grid_pixels)
+        place(self.linear, job, rows, cols, grid_colors)
+        return Tile(block, rows, cols, grid_pixels, grid_colors, last)

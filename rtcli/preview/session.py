@@ -14,6 +14,7 @@ page; `snapshot()` is what a page that arrives late is sent first.
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import os
 import queue
 import threading
@@ -23,13 +24,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.errors import RtcliError, error_line, one_line, shown
+from rtcli.errors import RtcliError, error_line, one_line, plural, shown
 from rtcli.preview import messages
 from rtcli.preview.passes import Progressive
 from rtcli.views import KINDS as VIEWS
 from rtcli.watch import Changes, recording
 
 POLL = 0.05                        # seconds between looks at the scene's files
+MAX_IDS = 65535                    # objects a signature's 16-bit ids tell apart (api.check_ids)
 PENDING = 16                       # questions waiting for the thread at most; more are refused (Busy)
 
 
@@ -49,6 +51,7 @@ class Options:
     gamma: bool = False
     bvh: bool = True
     frame: int = 1
+    workers: int | None = None     # threads tracing tiles with the compiled engine (default: all cores)
 
 
 class Session:
@@ -120,7 +123,10 @@ class Session:
             try:
                 loaded = load(self.path, None, lint=True)
                 base = of_loaded(loaded, self.path).override(o.width, o.height, o.samples, o.max_depth)
-                self.frame = min(self.frame, base.frames)
+                if self.frame > base.frames:
+                    self.say(f"note: frame {self.frame}: {shown(self.path)} has {plural(base.frames, 'frame')}; "
+                             f"showing frame {base.frames}")
+                    self.frame = base.frames
                 scene = base.at(self.frame)
             except (RtcliError, MemoryError) as e:
                 self._failed(e)
@@ -146,20 +152,25 @@ class Session:
         self.views, self.done, self.compare, self.progress = {}, None, None, None
         job = Job(scene.width, scene.height, gamma=o.gamma, engine=o.engine, bvh=o.bvh)
         try:
-            run = Progressive(scene.model, job, notes=lambda text: self.say(f"note: {text}"))
+            threads = o.workers or os.cpu_count() or 1
+            run = Progressive(scene.model, job, lambda text: self.say(f"note: {text}"), threads)
         except (RtcliError, MemoryError) as e:
             return self._failed(e)
         self.info = self._scene_info(scene)
         self.publish(self.info)
         if self.tev is not None:
             self.tev.begin(self._title(), scene.width, scene.height)
-        for tile in run.tiles():
-            self._show(run, tile)
-            if tile.last and tile.block == run.blocks[0]:
-                self.image = run.image                # a page arriving now sees the first pass, not black
-                self._signature()
-            if self._interrupted():
-                return
+        try:
+            with contextlib.closing(run.tiles()) as tiles:     # closed: the tiles in flight are waited for
+                for tile in tiles:
+                    self._show(run, tile)
+                    if tile.last and tile.block == run.blocks[0]:
+                        self.image = run.image        # a page arriving now sees the first pass, not black
+                        self._signature()
+                    if self._interrupted():
+                        return
+        except (RtcliError, MemoryError) as e:
+            return self._failed(e)
         self._finish(run)
 
     def _interrupted(self) -> bool:
@@ -180,8 +191,10 @@ class Session:
             self.tev.tile(tile)
 
     def _signature(self) -> None:
-        """The id map of the scene in hand (hover and outline on the page)."""
+        """The id map of the scene in hand (hover and outline on the page), when its ids fit in 16 bits."""
         from rtcli.api import signature
+        if len(self.scene.model.objects) > MAX_IDS:
+            return
         self.ids = np.asarray(signature(self.scene, workers=1))
         self.publish(messages.ids_message(self.render, self.ids))
 
@@ -215,7 +228,7 @@ class Session:
                 "samples": scene.model.settings.samples, "warnings": self.warnings,
                 "against": self.golden.about() if self.golden is not None else None,
                 "objects": [{"id": r.id, "name": one_line(r.name), "shape": r.shape, "material": one_line(r.material)}
-                            for r in object_rows(scene.model)]}
+                            for r in object_rows(scene.model)] if len(scene.model.objects) <= MAX_IDS else []}
 
     # --- questions, and the watch, between two tiles ---
 
