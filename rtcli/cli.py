@@ -506,7 +506,7 @@ def preview(scene_file, port, host, no_browser, width, height, samples, max_dept
             frame, against, tev):
     """Serve a live preview of SCENE.yaml in the browser: it renders coarse to fine, renders again at
     every save of the scene or a file it reads, and explains the pixel clicked. Ctrl-C ends it
-    (docs/preview.md)."""
+    (docs/preview.md). Needs the extra `preview`: pip install -e '.[preview]' in the rtcli folder."""
     from rtcli import api, runs
     from rtcli.preview import Options, serve
     api.check_engine(engine)

@@ -68,16 +68,16 @@ def save(path, text: str) -> None:
 
 
 class Preview:
-    """`rtcli preview SCENE --no-browser --port 0` as a process in `folder`; stop() ends it with
-    Ctrl-C (SIGINT) and returns its exit code and stderr."""
+    """`rtcli preview SCENE --port 0 --no-browser` as a process in `folder` (`browser`: without
+    --no-browser); stop() ends it with Ctrl-C (SIGINT) and returns its exit code and stderr."""
 
-    def __init__(self, folder, *options: str, scene: str = "scene.yaml"):
+    def __init__(self, folder, *options: str, scene: str = "scene.yaml", browser: bool = False, env=None):
         self.folder = folder
         self.err_path = folder.parent / f"{folder.name}.stderr"
         self.err = open(self.err_path, "w")
-        self.proc = subprocess.Popen([sys.executable, "-m", "rtcli", "preview", scene, "--no-browser", "--port", "0",
-                                      *options], cwd=folder, stdout=subprocess.PIPE, stderr=self.err, text=True,
-                                     start_new_session=True)
+        self.proc = subprocess.Popen([sys.executable, "-m", "rtcli", "preview", scene, "--port", "0", *options,
+                                      *([] if browser else ["--no-browser"])], cwd=folder, stdout=subprocess.PIPE,
+                                     stderr=self.err, text=True, start_new_session=True, env=env)
         self.lines: list[str] = []
         threading.Thread(target=self._read, daemon=True).start()
         self.url = self.wait_for(lambda: self.lines and self.lines[0], "the URL")

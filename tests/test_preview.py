@@ -371,6 +371,19 @@ def test_without_the_extra_it_says_which(tmp_path, monkeypatch):
         "(rtcli is not on the package index)\n")
 
 
+def test_the_browser_is_given_the_url_printed(tmp_path):
+    write_scene(tmp_path)
+    (tmp_path / "browser.py").write_text("import sys\nopen(sys.argv[0] + '.url', 'w').write(sys.argv[1])\n")
+    env = {**os.environ, "BROWSER": f"{sys.executable} {tmp_path / 'browser.py'} %s"}
+    preview = Preview(tmp_path, browser=True, env=env)
+    try:
+        opened = tmp_path / "browser.py.url"
+        preview.wait_for(lambda: opened.exists() and opened.read_text(), "the browser")
+        assert opened.read_text() == preview.url
+    finally:
+        assert preview.stop()[0] == 130
+
+
 def test_another_host_than_127_0_0_1_is_warned_about(tmp_path):
     try:
         socket.create_server(("127.0.0.2", 0)).close()

@@ -18,6 +18,7 @@ import asyncio
 import errno
 import os
 import secrets
+import sys
 import threading
 from collections.abc import Callable
 
@@ -71,7 +72,7 @@ async def _serve(scene, options, host, port, browser, golden, tev, url, say) -> 
         thread = threading.Thread(target=session.run, name="rtcli-preview", daemon=True)
         thread.start()
         if browser:
-            loop.run_in_executor(None, _open, f"http://{_bracketed(host)}:{bound}/?token={token}")
+            loop.run_in_executor(None, _open, f"http://{_bracketed(host)}:{bound}/?token={token}", say)
         try:
             await asyncio.Event().wait()
         finally:
@@ -113,6 +114,10 @@ def _post(loop, publish, message) -> None:
         pass
 
 
-def _open(url: str) -> None:
+def _open(url: str, say: Callable[[str], None]) -> None:
+    """Open the page in the user's browser ($BROWSER, else the system's), where there is a screen
+    to show it: without one, Python would pick a text browser, which would take the terminal."""
     import webbrowser
-    webbrowser.open(url)
+    screen = sys.platform in ("darwin", "win32") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    if not (os.environ.get("BROWSER") or screen) or not webbrowser.open(url):
+        say("note: no browser to open here: open the URL above in one")
