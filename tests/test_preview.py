@@ -332,8 +332,10 @@ def test_preview_outlives_vanishing_crowded_huge_and_malformed_requests(tmp_path
         np.testing.assert_array_equal(read_page(preview, lambda p: p.done()).picture, expected)
         assert rss(preview.proc.pid) - start < 150 << 20
     finally:
-        code, _ = preview.stop()
+        code, err = preview.stop()
     assert code == 130
+    assert [line.split(" ", 1)[1].split(" (")[0] for line in err.splitlines()] == \
+        ["rendered scene.yaml frame 1", "interrupted"]                 # no traceback, no line per bad request
 
 
 # --- the command line's errors ---

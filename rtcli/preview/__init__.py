@@ -58,7 +58,7 @@ def serve(scene: str, options: Options, *, host: str = "127.0.0.1", port: int = 
 async def _serve(scene, options, host, port, browser, golden, tev, url, say) -> None:
     from aiohttp import web
 
-    from rtcli.preview.server import Preview
+    from rtcli.preview.server import Preview, logging_to
     loop, token = asyncio.get_running_loop(), secrets.token_urlsafe(24)
     session = Session(scene, options, lambda message: _post(loop, preview.publish, message), say, golden, tev)
     preview = Preview(session, token, set(), "", golden)
@@ -66,18 +66,20 @@ async def _serve(scene, options, host, port, browser, golden, tev, url, say) -> 
                            shutdown_timeout=1)
     await runner.setup()
     try:
-        bound = await _listen(runner, host, port)
-        preview.origins, preview.cookie = _origins(host, bound), f"rtcli-preview-{bound}"
-        url(f"http://{_bracketed(host)}:{bound}/?token={token}")
-        thread = threading.Thread(target=session.run, name="rtcli-preview", daemon=True)
-        thread.start()
-        if browser:
-            loop.run_in_executor(None, _open, f"http://{_bracketed(host)}:{bound}/?token={token}", say)
-        try:
-            await asyncio.Event().wait()
-        finally:
-            session.stop()
-            thread.join(timeout=2)
+        with logging_to(say):
+            bound = await _listen(runner, host, port)
+            preview.origins, preview.cookie = _origins(host, bound), f"rtcli-preview-{bound}"
+            address = f"http://{_bracketed(host)}:{bound}/?token={token}"
+            url(address)
+            thread = threading.Thread(target=session.run, name="rtcli-preview", daemon=True)
+            thread.start()
+            if browser:
+                loop.run_in_executor(None, _open, address, say)
+            try:
+                await asyncio.Event().wait()
+            finally:
+                session.stop()
+                thread.join(timeout=2)
     finally:
         await runner.cleanup()
 

@@ -17,11 +17,14 @@ from __future__ import annotations
 
 import asyncio
 import collections
+import contextlib
 import hmac
 import json
+import logging
 from importlib import resources
 
 from aiohttp import WSCloseCode, WSMsgType, web
+from aiohttp.http_exceptions import HttpProcessingError
 
 from rtcli.errors import RtcliError, one_line
 from rtcli.preview.session import Busy, Session
@@ -57,7 +60,14 @@ class Page:
         self.wake.set()
 
     async def pump(self, snapshot) -> None:
-        """Send what waits, as the page reads it; after falling behind, the snapshot first."""
+        """Send what waits, as the page reads it; after falling behind, the snapshot first. A page
+        that has gone is the websocket handler's to forget."""
+        try:
+            await self._pump(snapshot)
+        except ConnectionError:
+            pass
+
+    async def _pump(self, snapshot) -> None:
         while not self.ws.closed:
             await self.wake.wait()
             self.wake.clear()
@@ -69,6 +79,36 @@ class Page:
                 message = self.waiting.popleft()
                 self.size -= len(message)
                 await (self.ws.send_bytes(message) if isinstance(message, bytes) else self.ws.send_str(message))
+
+
+class Log(logging.Handler):
+    """aiohttp's log as rtcli's lines: a request that breaks off or is malformed is the client's
+    affair and said nowhere (the client got its 400); anything else is one line, not a traceback."""
+
+    def __init__(self, say):
+        super().__init__(logging.WARNING)
+        self.say = say
+
+    def emit(self, record: logging.LogRecord) -> None:
+        error = record.exc_info[1] if record.exc_info else None
+        if isinstance(error, (ConnectionError, HttpProcessingError)):
+            return
+        why = f": {type(error).__name__}: {error}" if error is not None else ""
+        self.say(f"note: the preview's web server: {one_line(record.getMessage() + why)}")
+
+
+@contextlib.contextmanager
+def logging_to(say):
+    """aiohttp's log through `say` (Log) within the block."""
+    logger, handler = logging.getLogger("aiohttp"), Log(say)
+    propagate = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
 
 
 def encoded(message) -> bytes | str:
@@ -145,7 +185,7 @@ class Preview:
         if len(self.pages) >= MAX_PAGES:
             raise web.HTTPServiceUnavailable(text=f"503: {MAX_PAGES} pages are open already\n")
         ws = web.WebSocketResponse(max_msg_size=MESSAGE_BYTES, heartbeat=30, compress=False)
-        await ws.prepare(request)
+        await ws.prepare(request)                  # a page gone by now raises ConnectionError: said nowhere (Log)
         page = Page(ws)
         for message in self.snapshot():
             page.put(message)
