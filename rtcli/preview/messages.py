@@ -12,7 +12,7 @@ Pictures go as binary messages, a 16-byte header then the data, little-endian:
 
 A page draws a tile's cols x rows values as blocks of block x block pixels from (x, y),
 clipped to the image. Everything else is a JSON object with a "type" (scene, progress, done,
-error, compare).
+error, compare, note).
 """
 
 from __future__ import annotations

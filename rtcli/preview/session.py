@@ -138,6 +138,11 @@ class Session:
             for line in self.warnings:
                 self.say(line)
 
+    def _note(self, text: str) -> None:
+        """A note of the engine's (that it compiles, once, and how long it took), on stderr and the pages."""
+        self.say(f"note: {text}")
+        self.publish({"type": "note", "line": f"note: {text}"})
+
     def _failed(self, e: BaseException) -> None:
         self.error = error_line(e)
         self.say(self.error)
@@ -152,8 +157,7 @@ class Session:
         self.views, self.done, self.compare, self.progress = {}, None, None, None
         job = Job(scene.width, scene.height, gamma=o.gamma, engine=o.engine, bvh=o.bvh)
         try:
-            threads = o.workers or os.cpu_count() or 1
-            run = Progressive(scene.model, job, lambda text: self.say(f"note: {text}"), threads)
+            run = Progressive(scene.model, job, self._note, o.workers or os.cpu_count() or 1)
         except (RtcliError, MemoryError) as e:
             return self._failed(e)
         self.info = self._scene_info(scene)

@@ -100,7 +100,8 @@
   function setState(name) { document.body.dataset.state = name; }
 
   function onJson(m) {
-    const on = { scene: onScene, progress: onProgress, done: onDone, error: onError, compare: onCompare }[m.type];
+    const on = { scene: onScene, progress: onProgress, done: onDone, error: onError, compare: onCompare,
+      note: (n) => { $("status").textContent = n.line; } }[m.type];
     if (on) on(m);
   }
 
@@ -109,6 +110,7 @@
     document.body.dataset.render = String(m.render);
     setState("rendering");
     $("title").textContent = m.title;
+    $("status").textContent = "rendering";
     document.title = `${m.title} · rtcli preview`;
     if (m.width !== state.width || m.height !== state.height) resize(m.width, m.height);
     state.blocks = [16, 8, 4, 2, 1].filter((b) => b === 1 || b < Math.max(m.width, m.height));
