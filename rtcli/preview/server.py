@@ -121,6 +121,7 @@ class Preview:
     def __init__(self, session: Session, token: str, origins: set[str], cookie: str, golden=None):
         self.session, self.token, self.origins, self.cookie, self.golden = session, token, origins, cookie, golden
         self.pages: set[Page] = set()
+        self._snapshot: tuple[int, list] = (-1, [])
 
     def publish(self, message) -> None:
         """Send a message from the session to every page (in the server's thread)."""
@@ -129,7 +130,11 @@ class Preview:
             page.put(text)
 
     def snapshot(self) -> list:
-        return [encoded(m) for m in self.session.snapshot()]
+        """The session's snapshot, encoded once for all the pages that arrive before it changes."""
+        version = self.session.version
+        if self._snapshot[0] != version:
+            self._snapshot = (version, [encoded(m) for m in self.session.snapshot()])
+        return self._snapshot[1]
 
     def app(self) -> web.Application:
         app = web.Application(middlewares=[self.guard], client_max_size=MESSAGE_BYTES)

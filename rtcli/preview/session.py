@@ -60,6 +60,7 @@ class Session:
     def __init__(self, path: str, options: Options, publish: Callable, say: Callable[[str], None],
                  golden=None, tev=None):
         self.path, self.options, self.publish, self.say = path, options, publish, say
+        self.version = 0                             # how many messages were published: the snapshot's age
         self.golden, self.tev = golden, tev          # against.Golden, tev.Tev (or None)
         self.frame = options.frame
         self.requests: queue.Queue = queue.Queue(PENDING)
@@ -94,6 +95,10 @@ class Session:
 
     def stop(self) -> None:
         self._stopping.set()
+
+    def _send(self, message) -> None:
+        self.version += 1
+        self.publish(message)
 
     # --- the thread ---
 
@@ -141,12 +146,12 @@ class Session:
     def _note(self, text: str) -> None:
         """A note of the engine's (that it compiles, once, and how long it took), on stderr and the pages."""
         self.say(f"note: {text}")
-        self.publish({"type": "note", "line": f"note: {text}"})
+        self._send({"type": "note", "line": f"note: {text}"})
 
     def _failed(self, e: BaseException) -> None:
         self.error = error_line(e)
         self.say(self.error)
-        self.publish({"type": "error", "line": self.error})
+        self._send({"type": "error", "line": self.error})
 
     def _render(self) -> None:
         """Render the scene in hand pass by pass; return early when a file changes, another frame
@@ -161,7 +166,7 @@ class Session:
         except (RtcliError, MemoryError) as e:
             return self._failed(e)
         self.info = self._scene_info(scene)
-        self.publish(self.info)
+        self._send(self.info)
         if self.tev is not None:
             self.tev.begin(self._title(), scene.width, scene.height)
         try:
@@ -185,12 +190,12 @@ class Session:
     def _show(self, run: Progressive, tile) -> None:
         if self.error is not None:
             self.error = None
-            self.publish({"type": "error", "line": None})
-        self.publish(messages.tile_message(self.render, tile.block, tile.rows, tile.cols, tile.pixels))
+            self._send({"type": "error", "line": None})
+        self._send(messages.tile_message(self.render, tile.block, tile.rows, tile.cols, tile.pixels))
         p = run.progress
         self.progress = {"type": "progress", "render": self.render, "block": tile.block, "last": tile.last,
                          "traced": p.traced, "pixels": p.pixels, "seconds": p.seconds, "eta": p.eta}
-        self.publish(self.progress)
+        self._send(self.progress)
         if self.tev is not None:
             self.tev.tile(tile)
 
@@ -200,7 +205,7 @@ class Session:
         if len(self.scene.model.objects) > MAX_IDS:
             return
         self.ids = np.asarray(signature(self.scene, workers=1))
-        self.publish(messages.ids_message(self.render, self.ids))
+        self._send(messages.ids_message(self.render, self.ids))
 
     def _finish(self, run: Progressive) -> None:
         """The render is done: its stats, the golden comparison, tev's channels."""
@@ -209,11 +214,11 @@ class Session:
         stats = RenderStats.of(scene.width, scene.height, scene.model.settings.samples, s, run.progress.seconds,
                                start_up=False)
         self.done = {"type": "done", "render": self.render, "seconds": run.progress.seconds, "stats": stats.line()}
-        self.publish(self.done)
+        self._send(self.done)
         self.say(f"rendered {self._title()} ({scene.width}x{scene.height}) in {run.progress.seconds:.2f} s")
         if self.golden is not None:
             self.compare = self.golden.compare(self.render, self.image)
-            self.publish(self.compare)
+            self._send(self.compare)
         if self.tev is not None:
             self.tev.image(run.linear)
             for kind in VIEWS:
@@ -254,8 +259,9 @@ class Session:
     def _answer(self, what: str, args: tuple, future: concurrent.futures.Future) -> None:
         if not future.set_running_or_notify_cancel():
             return
+        answer = {"explain": self._explain, "view": self._view, "frame": self._frame}[what]
         try:
-            future.set_result(getattr(self, f"_{what}")(*args))
+            future.set_result(answer(*args))
         except (RtcliError, MemoryError) as e:
             future.set_exception(RtcliError(one_line(str(e) or "out of memory")))
         except Exception as e:             # noqa: BLE001 -- a bug: the page says so, and the preview goes on
@@ -287,8 +293,8 @@ class Session:
 
     def _frame(self, k: int) -> int:
         """Show frame k (a page's frame slider); the frame shown."""
-        if self.base is None or not 1 <= k <= self.base.frames:
-            raise RtcliError(f"frame {k}: the scene has {self.base.frames if self.base else 0} frames")
+        if self.base is None:
+            raise RtcliError("the scene has not loaded: no frame to show")
         if k != self.frame:
-            self.frame, self.scene, self._rerender = k, self.base.at(k), True
+            self.scene, self.frame, self._rerender = self.base.at(k), k, True       # at(): an error for a bad k
         return self.frame
