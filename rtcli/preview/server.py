@@ -18,6 +18,7 @@ from __future__ import annotations
 import asyncio
 import collections
 import contextlib
+import functools
 import hmac
 import json
 import logging
@@ -38,7 +39,9 @@ CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' 
        "connect-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'")
 
 
+@functools.cache
 def _asset(name: str) -> bytes:
+    """A file of the page, read from rtcli's package once."""
     return resources.files("rtcli.preview").joinpath("assets", name).read_bytes()
 
 

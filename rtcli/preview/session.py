@@ -26,7 +26,7 @@ import numpy as np
 
 from rtcli.errors import RtcliError, error_line, one_line, plural, shown
 from rtcli.preview import messages
-from rtcli.preview.passes import Progressive
+from rtcli.preview.passes import Progressive, passes
 from rtcli.views import KINDS as VIEWS
 from rtcli.watch import Changes, recording
 
@@ -85,11 +85,16 @@ class Session:
         return future
 
     def snapshot(self) -> list:
-        """What a page is sent when it arrives: the scene, the picture as it is, the id map, how
-        far the render is, its error."""
+        """What a page is sent when it arrives: the scene, the picture as it is (first as the
+        first pass left it, a few kilobytes, then whole), the id map, how far the render is, its
+        error."""
         image, ids = self.image, self.ids
-        pictures = [messages.image_message(self.render, image) if image is not None else None,
-                    messages.ids_message(self.render, ids) if ids is not None else None]
+        pictures = [None, None, messages.ids_message(self.render, ids) if ids is not None else None]
+        if image is not None:
+            b = passes(*image.shape[1::-1])[0]                  # the first pass's grid points keep their colors
+            rows, cols = np.arange(0, image.shape[0], b), np.arange(0, image.shape[1], b)
+            pictures[:2] = [messages.tile_message(self.render, b, rows, cols, image[::b, ::b]),
+                            messages.image_message(self.render, image)]
         out = [self.info, *pictures, self.progress, self.done, self.compare, {"type": "error", "line": self.error}]
         return [m for m in out if m is not None]
 
