@@ -88,23 +88,27 @@ def task_costs(address: str, workers: int, runs: int = 200) -> tuple[float, floa
     """(work, round trip, busy time a task adds to a worker), in seconds, of tile groups of one
     pixel of the Whitted scene, whose built scene every worker keeps after its first task."""
     sys.path.insert(0, ROOT)
-    from rtcli import cluster, frames
-    from rtcli.render import Job, plan, prepare, run_tiles
-    loaded = frames.load(os.path.join(ROOT, "scenes", "whitted.yaml"), keep=True)
+    from rtcli.api.loading import load_file
+    from rtcli.cluster.renders import bundle
+    from rtcli.cluster.session import Session
+    from rtcli.cluster.target import Target
+    from rtcli.cluster.tasks import tiles_task
+    from rtcli.rendering.tiles import Job, plan, prepare, run_tiles
+    loaded = load_file(os.path.join(ROOT, "scenes", "whitted.yaml"), keep=True)
     job = Job(1, 1)
     tiles, traced = plan(loaded.scene, job)
-    engine = prepare(loaded.scene, job, traced)
+    engine, _ = prepare(loaded.scene, job, traced)
     here = []
     for _ in range(runs):
         start = time.perf_counter()
         run_tiles(loaded.scene, engine, job, tiles)
         here.append(time.perf_counter() - start)
-    with cluster.Session(cluster.Target(address)) as session:
+    with Session(Target(address)) as session:
         client = session.client
-        spec, blobs = session.send(loaded.bundle, {})
+        spec, blobs = session.send(bundle(loaded), {})
 
         def submit():
-            return client.submit(cluster.tiles_task, spec, blobs, 1, job, traced, tiles, pure=False)
+            return client.submit(tiles_task, spec, blobs, 1, job, traced, tiles, pure=False)
         client.gather([submit() for _ in range(8 * workers)])         # every worker has built the scene
         trips = []
         for _ in range(runs // 4):
@@ -119,12 +123,13 @@ def task_costs(address: str, workers: int, runs: int = 200) -> tuple[float, floa
 
 def bundle_sizes() -> list[tuple[str, int, int]]:
     sys.path.insert(0, ROOT)
-    from rtcli import frames
+    from rtcli.api.loading import load_file
+    from rtcli.cluster.renders import bundle
     out = []
     for name in sorted(os.listdir(os.path.join(ROOT, "scenes"))):
         if name.endswith(".yaml"):
-            bundle = frames.load(os.path.join(ROOT, "scenes", name), keep=True).bundle
-            out.append((name, len(bundle.manifest), bundle.size))
+            files = bundle(load_file(os.path.join(ROOT, "scenes", name), keep=True))
+            out.append((name, len(files.manifest), files.size))
     return out
 
 

@@ -63,7 +63,7 @@ def embree_rate(width: int, height: int, runs: int) -> tuple[float, int]:
     from embreex.mesh_construction import TriangleMesh
 
     import rtcli
-    from rtcli.render import camera_rays
+    from rtcli.wavefront.rays import camera_rays
     model = rtcli.load_scene(os.path.join(HERE, "torus100k.yaml"), width=width, height=height).model
     light = np.asarray(model.lights[0].position, dtype=float)
     tris = torus_triangles()

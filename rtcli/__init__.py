@@ -5,7 +5,7 @@
 
 The API (docs/python-api.md) is imported on first use, so `import rtcli` stays cheap
 for the command line. `rtcli.render` is the API's function; the tile renderer it
-drives is the module of the same name, imported as `from rtcli.render import ...`.
+drives is the module of the same name, imported as `from rtcli.rendering.tiles import ...`.
 """
 
 import sys
@@ -14,10 +14,11 @@ import types
 __version__ = "0.1.0"
 
 _EXPORTS = {
-    "load_scene": "rtcli.api", "render": "rtcli.api", "signature": "rtcli.api", "legend": "rtcli.api",
-    "LegendRow": "rtcli.api", "diff": "rtcli.diffs", "Difference": "rtcli.diffs", "Scene": "rtcli.scene_api",
-    "ImageArray": "rtcli.results", "RenderStats": "rtcli.results", "RtcliError": "rtcli.errors",
-    "SceneError": "rtcli.errors", "RtcliWarning": "rtcli.errors", "view": "rtcli.views", "explain": "rtcli.explain",
+    "load_scene": "rtcli.api", "render": "rtcli.api", "signature": "rtcli.api", "view": "rtcli.api",
+    "explain": "rtcli.api", "legend": "rtcli.api.pictures", "LegendRow": "rtcli.api.pictures",
+    "Scene": "rtcli.api.scene", "ImageArray": "rtcli.api.results", "RenderStats": "rtcli.api.results",
+    "diff": "rtcli.compare.difference", "Difference": "rtcli.compare.difference", "RtcliError": "rtcli.errors",
+    "SceneError": "rtcli.errors", "RtcliWarning": "rtcli.errors",
 }
 __all__ = ["__version__", *_EXPORTS]
 
@@ -38,7 +39,7 @@ def __dir__() -> list:
 
 class _Package(types.ModuleType):
     """This package, whose API names win over submodules of the same name: importing a submodule
-    sets the package's attribute of that name (rtcli.render the module would hide rtcli.render
+    sets the package's attribute of that name (rtcli.rendering.tiles the module would hide rtcli.rendering.tiles
     the function); here that attribute is left to the API. The submodule stays in sys.modules."""
 
     def __setattr__(self, name, value):

@@ -21,7 +21,7 @@ from rtcli import __version__
 from rtcli.errors import Interrupted, RtcliError, error_line, one_line, shown
 
 SIZE = click.IntRange(1, 32768)
-VIEWS = ("normal", "depth", "uv", "albedo", "bounces", "ids")          # rtcli/views.py, not imported to start
+VIEWS = ("normal", "depth", "uv", "albedo", "bounces", "ids")          # rtcli/inspect/views.py, not imported to start
 
 
 def _on_signal(signum, frame):
@@ -93,9 +93,8 @@ def _load(path: str, frame: int | None = None, keep: bool = False, lint=None, **
     """(frames.Loaded, api.Scene) of a scene file at frame `frame` (default 1), with the command
     line's overrides; `keep`: also the files' bytes, for a cluster; `lint` (lint.Lint): what to
     do with its warnings."""
-    from rtcli.frames import load
-    from rtcli.scene_api import of_loaded
-    loaded = load(path, frame, keep=keep, lint=lint is not None and lint.wanted)
+    from rtcli.api.loading import load_file, of_loaded
+    loaded = load_file(path, frame, keep=keep, lint=lint is not None and lint.wanted)
     if lint is not None:
         lint.report(loaded.warnings, path, loaded.animation.frames)
     return loaded, of_loaded(loaded, path).override(**overrides)
@@ -112,7 +111,7 @@ def _output(scene_path: str, out: str | None, suffix: str = ".png") -> str:
 
 
 def _check_outputs(outputs, inputs) -> None:
-    from rtcli.outputs import check_outputs
+    from rtcli.rendering.outputs import check_outputs
     check_outputs(outputs, inputs)
 
 
@@ -139,8 +138,8 @@ def _cluster(address, file, local):
     if not (address or file or local):
         return None
     from rtcli import runs
-    from rtcli.cluster import target
-    from rtcli.frames import Reach
+    from rtcli.cluster.renders import Reach
+    from rtcli.cluster.target import target
     return Reach(target(address, file, local), runs.note)
 
 
@@ -189,9 +188,11 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
            strict, keep_going, cluster, cluster_file, local_cluster, watch):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
-    from rtcli import api, batch, runs
-    from rtcli import frames as animation
-    from rtcli.movie import is_movie
+    from rtcli import api, runs
+    from rtcli.api.options import check_engine
+    from rtcli.rendering import batch
+    from rtcli.rendering import frames as animation
+    from rtcli.rendering.movie import is_movie
     if as_json and not stats:
         raise click.UsageError("--json goes with --stats")
     if view and stats:
@@ -206,7 +207,7 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
                                "or a movie")
     if view and (cluster or cluster_file or local_cluster):
         raise click.UsageError("--view is computed on this machine: it takes no cluster option")
-    api.check_engine(engine)
+    check_engine(engine)
     if watch and several:
         raise click.UsageError("--watch renders one scene file")
     if watch and (sequence or skip_existing):
@@ -217,6 +218,9 @@ def render(scene_files, output, width, height, block_size, samples, max_depth, w
     if keep_going and (watch or sequence):
         raise click.UsageError("--keep-going renders the other scenes when one is broken: it takes no --watch, "
                                "--frames, frame pattern or movie")
+    if stats:                       # why a machine code file is not used, if one is not
+        from rtcli import machinecode
+        machinecode.report_to(runs.note)
     where = _cluster(cluster, cluster_file, local_cluster)
     bar = not quiet and (progress or sys.stderr.isatty())
     lint = runs.lint(quiet, strict, several, watch)
@@ -287,7 +291,9 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     import numpy as np
 
     from rtcli import api, runs
-    from rtcli.writer import signature_colors, write_images
+    from rtcli.api.pictures import check_ids, legend
+    from rtcli.core.display import signature_colors
+    from rtcli.rendering.writer import write_images
     where = _cluster(cluster, cluster_file, local_cluster)
     loaded, scene = _load(scene_file, frame, keep=where is not None)
     out = _output(scene_file, output, ".sig.png")
@@ -296,14 +302,14 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     if where is None:
         ids = api.signature(scene, width=width, height=height, block_size=block_size, workers=workers)
     else:
-        api.check_ids(scene)
+        check_ids(scene)
         with where:
             ids = runs.on_cluster(loaded, scene, where, dict(samples=None, max_depth=None), width, height, block_size,
                               signature=True)
     write_images([(out, signature_colors(ids))] + ([(ids_out, np.asarray(ids))] if ids_out else []))
     if legend:
         click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
-        for row in api.legend(scene, ids):
+        for row in legend(scene, ids):
             click.echo(f"{row.id:>5}  {one_line(row.name) or '-':<24} {row.shape:<10} {row.pixels:>9}")
 
 
@@ -326,7 +332,7 @@ def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_sam
     """Explain why pixel (X, Y) has its color: its ray tree, every term of the shading equation
     with its numbers, and the sum at every ray (X from the left, Y from the top, from 0)."""
     from rtcli import runs
-    from rtcli.explain import explain as explain_pixel
+    from rtcli.api import explain as explain_pixel
     if sample is not None and all_samples:
         raise click.UsageError("--sample and --all-samples go one at a time")
     _, scene = _load(scene_file, frame)
@@ -380,13 +386,13 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
     Given two folders, compare every .png in them paired by relative path: exit 0 when every
     pair passes, 1 when one fails or is missing or extra.
     """
-    from rtcli import compare as cmp
-    from rtcli.writer import write_images
+    from rtcli.compare import images as cmp
+    from rtcli.rendering.writer import write_images
     id_options = dict(max_boundary_mismatch=max_boundary_mismatch, max_boundary_fraction=max_boundary_fraction)
     image_options = dict(tolerance=tolerance, max_bad_pixels=max_bad_pixels,
                          max_bad_fraction=max_bad_fraction, max_cluster=max_cluster)
     if _folders(actual, expected, diff or flip_out or ids_mode, report_dir or junit_file):
-        from rtcli.compare_dirs import compare_dirs
+        from rtcli.compare.suite import compare_dirs
         if not compare_dirs(actual, expected, image_options, id_options, report_dir, junit_file, click.echo):
             raise click.exceptions.Exit(1)
         return
@@ -414,7 +420,7 @@ def compare(actual, expected, diff, flip_out, ids_mode, tolerance, max_bad_pixel
 def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
     """Whether compare is given two folders; a usage error for a folder and a file, or for options
     of the other mode."""
-    from rtcli.compare_dirs import are_folders
+    from rtcli.compare.suite import are_folders
     folders = are_folders(actual, expected)
     if folders and pair_options:
         raise click.UsageError("--diff, --flip and --ids compare two images; two folders get --report")
@@ -431,10 +437,10 @@ def _folders(actual: str, expected: str, pair_options, folder_options) -> bool:
 def validate(scene_file, list_objects, strict):
     """Parse and check a scene, every frame of an animated one; print a summary, and warnings about
     likely mistakes on stderr. Renders only a small signature (does the camera see anything?)."""
-    from rtcli import checks, lint
-    from rtcli.frames import load
+    from rtcli.api.loading import load_file
+    from rtcli.inspect import checks, lint
     from rtcli.scenefile.build import summary
-    loaded = load(scene_file, lint=True)
+    loaded = load_file(scene_file, lint=True)
     frames = loaded.animation.check_all()
     scene, found = loaded.scene, loaded.warnings
     if strict and found:
@@ -457,13 +463,14 @@ def warmup(cluster, cluster_file, local_cluster):
 
     where = _cluster(cluster, cluster_file, local_cluster)
     if where is not None:
-        from rtcli.cluster_engine import warm
+        from rtcli.cluster.warm import warm
         with where:
             return warm(where.session(), click.echo)
     from rtcli import machinecode, variants
     from rtcli.compiled.warmup import bytecode
     from rtcli.compiled.warmup import warmup as warm
     start = time.perf_counter()
+    machinecode.report_to(lambda text: click.echo(f"note: {text}", err=True))
     where = variants.cache_location() if variants.ENABLED else None
     if where is not None:
         click.echo(f"cache: {where} ({where.why})" if where.enabled else f"cache: none ({where.why}); "
@@ -507,9 +514,10 @@ def preview(scene_file, port, host, no_browser, width, height, samples, max_dept
     """Serve a live preview of SCENE.yaml in the browser: it renders coarse to fine, renders again at
     every save of the scene or a file it reads, and explains the pixel clicked. Ctrl-C ends it
     (docs/preview.md). Needs the extra `preview`: pip install -e '.[preview]' in the rtcli folder."""
-    from rtcli import api, runs
+    from rtcli import runs
+    from rtcli.api.options import check_engine
     from rtcli.preview import Options, serve
-    api.check_engine(engine)
+    check_engine(engine)
     options = Options(width, height, samples, max_depth, engine, gamma, not no_bvh, frame, workers)
     serve(scene_file, options, host=host, port=port, browser=not no_browser, against=against, tev=tev,
           url=lambda text: click.echo(text), say=runs.stamped)

@@ -12,7 +12,7 @@ import time
 import click
 
 from rtcli.errors import one_line, shown
-from rtcli.outputs import check_outputs
+from rtcli.rendering.outputs import check_outputs
 
 
 def size(model, width, height) -> tuple[int, int]:
@@ -25,8 +25,8 @@ def size(model, width, height) -> tuple[int, int]:
 
 def check_size(model, width, height) -> tuple[int, int, str | None]:
     """api.image_size, its errors naming the options --width and --height."""
-    from rtcli import api
-    return api.image_size(model, width, height, ("--width", "--height"))
+    from rtcli.api.options import image_size
+    return image_size(model, width, height, ("--width", "--height"))
 
 
 _terminal = threading.Lock()          # the progress bar and the notes share stderr's last line
@@ -56,7 +56,7 @@ def note(text: str) -> None:
 def lint(quiet: bool, strict: bool, several: bool, watch: bool):
     """What render does with a scene's warnings (lint.Lint): printed on stderr (after the time
     in a watch, as its other lines), hidden by --quiet, errors with --strict."""
-    from rtcli.lint import Lint
+    from rtcli.inspect.lint import Lint
     return Lint(stamped if watch else echo_err, quiet, strict, several)
 
 
@@ -75,17 +75,18 @@ def clock() -> str:
 
 
 def make_job(model, width, height, block_size, **kw):
-    from rtcli.render import Job
+    from rtcli.rendering.tiles import Job
     return Job(*size(model, width, height), block_size, **kw)
 
 
 def on_cluster(loaded, scene, where, changes: dict, width, height, block_size, progress=None, **kw):
-    """The still (frames.render_image) of `loaded` traced on the cluster, as api.render returns it."""
-    from rtcli.frames import overrides, render_image
-    from rtcli.results import ImageArray, RenderStats
+    """The still of `loaded` traced on the cluster (rtcli/cluster/renders.py), as api.render returns it."""
+    from rtcli.api.results import ImageArray, RenderStats
+    from rtcli.cluster.renders import still
+    from rtcli.rendering.frames import overrides
     job = make_job(scene.model, width, height, block_size, **kw)
     start = time.perf_counter()
-    pixels, counts = render_image(loaded, job, 1, progress, where, overrides(**changes))
+    pixels, counts = still(where, loaded, job, progress, overrides(**changes))
     s = scene.model.settings
     stats = RenderStats.of(job.width, job.height, 1 if job.signature else s.samples, counts,
                            time.perf_counter() - start, start_up=False)
@@ -96,10 +97,11 @@ def render_frames(scene_file: str, output, frame_range, frame, movie, skip_exist
                   changes: dict, workers, bar: bool, stats, lint=None) -> None:
     """An animation's frames to files or movies (frames.py), each file written as its frame is done;
     `stats`: None, "line" or "json"; `lint` (lint.Lint): what to do with the scene's warnings."""
-    from rtcli import batch
-    from rtcli import frames as animation
+    from rtcli.api.loading import load_file
+    from rtcli.rendering import batch
+    from rtcli.rendering import frames as animation
     start = time.perf_counter()
-    loaded = animation.load(scene_file, None, keep=where is not None, lint=lint is not None and lint.wanted)
+    loaded = load_file(scene_file, None, keep=where is not None, lint=lint is not None and lint.wanted)
     if lint is not None:
         lint.report(loaded.warnings, scene_file, loaded.animation.frames)
     seq = animation.sequence(loaded.animation, scene_file, output, frame_range, frame, movie)
@@ -118,16 +120,20 @@ def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: 
                      skip_existing: bool, start: float) -> None:
     import json
 
-    from rtcli import frames as animation
-    from rtcli.results import RenderStats
+    from rtcli.api.results import RenderStats
+    from rtcli.cluster.renders import frames as cluster_frames
+    from rtcli.rendering import frames as animation
     scene = loaded.scene
     animation.apply(scene, changes)            # the other frames are checked as written, then changed alike
     size = job.pop("width"), job.pop("height"), job.pop("block_size")
     job = make_job(scene, *size, **job)
     show = progress_bar(bar, one_line(os.path.basename(scene_file)))
     todo, rendering = animation.to_render(seq, skip_existing, job), time.perf_counter()
-    counts = animation.render_sequence(loaded, seq, job, workers or os.cpu_count() or 1, changes, skip_existing,
-                                       show, where)
+    if where is None:
+        frames = lambda todo: animation.local_frames(loaded, todo, job, workers or os.cpu_count() or 1, changes, show)
+    else:
+        frames = lambda todo: cluster_frames(where, loaded, todo, job, changes, show)
+    counts = animation.render_sequence(loaded, seq, job, skip_existing, frames)
     if not stats:
         return
     done = RenderStats.of(job.width, job.height, scene.settings.samples, counts, time.perf_counter() - rendering,
@@ -143,9 +149,9 @@ def _render_sequence(loaded, seq, scene_file: str, changes: dict, workers, bar: 
 def watch_scene(item, load, render_one, stats: bool, as_json: bool) -> None:
     """render --watch: the scene to its image now and after every change, until Ctrl-C. With
     --json, stdout holds only the JSON lines (the watch's own lines go to stderr)."""
-    from rtcli import batch
-    from rtcli.outputs import check_file_output
-    from rtcli.watch import watch
+    from rtcli.rendering import batch
+    from rtcli.rendering.outputs import check_file_output
+    from rtcli.rendering.watch import watch
     check_file_output(item.output, [item.scene])        # the scene as its own output: refused at once
 
     def once() -> None:
@@ -164,13 +170,14 @@ def missing(items: list, width, height) -> list:
     """--skip-existing with several scenes: the items (batch.Item) without an image of the size the
     scene renders at (an image of another size is rendered again). A scene whose image exists is
     loaded to learn its size; one that fails to load stays in, to fail where it renders."""
+    from rtcli.api.loading import load_file
     from rtcli.errors import RtcliError
-    from rtcli.frames import has_image, load
+    from rtcli.rendering.frames import has_image
     todo = []
     for item in items:
         if os.path.isfile(item.output):
             try:
-                w, h, _ = check_size(load(item.scene).scene, width, height)
+                w, h, _ = check_size(load_file(item.scene).scene, width, height)
             except RtcliError:
                 w = h = 0
             if w and has_image(item.output, w, h):
@@ -180,10 +187,11 @@ def missing(items: list, width, height) -> list:
 
 
 def view(scene, kind: str, width, height, tile: int, label: str | None):
-    """A debug view's picture (rtcli/views.py), its summary line printed; the ids view as its id
+    """A debug view's picture (rtcli/inspect/views.py), its summary line printed; the ids view as its id
     map, which `rtcli compare --ids` reads (README.md, Commands)."""
-    from rtcli.results import ImageArray
-    from rtcli.views import summary, view
+    from rtcli.api import view
+    from rtcli.api.results import ImageArray
+    from rtcli.inspect.views import summary
     data = view(scene, kind, width=width, height=height, tile=tile)
     click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
     return data if data.is_ids else ImageArray(data.to_8bit(), inputs=scene.inputs)

@@ -127,11 +127,22 @@ def user_cache_dir() -> str:
 def writable(folder: str) -> bool:
     """Whether files can be made in `folder` (made if missing): numba's own test of a cache folder."""
     try:
-        os.makedirs(folder, exist_ok=True)
+        make_private(folder)
         tempfile.TemporaryFile(dir=folder).close()
     except OSError:
         return False
     return True
+
+
+def make_private(folder: str) -> None:
+    """Make `folder` and each missing folder above it with mode 0700: only this user may read or
+    change what rtcli caches there (docs/architecture.md, Trust in the machine code files)."""
+    missing, path = [], os.path.abspath(folder)
+    while not os.path.isdir(path) and os.path.dirname(path) != path:
+        missing.append(path)
+        path = os.path.dirname(path)
+    for path in reversed(missing):
+        os.makedirs(path, mode=0o700, exist_ok=True)
 
 
 @functools.lru_cache(maxsize=None)
@@ -144,15 +155,25 @@ def cache_location() -> CacheLocation:
         root = os.environ.get(name)
         if root:
             root = os.path.abspath(os.path.expanduser(root))
-            return CacheLocation(root, name) if writable(root) else CacheLocation(root, f"{name} is not writable",
-                                                                                    False)
+            return _private_location(CacheLocation(root, name)) if writable(root) else CacheLocation(
+                root, f"{name} is not writable", False)
     beside = CacheLocation(None, "beside the sources")
     if all(writable(f) for f in beside.folders()):
         return beside
     root = user_cache_dir()
     if writable(root):
-        return CacheLocation(root, "the per-user cache: rtcli's folder is read-only")
+        return _private_location(CacheLocation(root, "the per-user cache: rtcli's folder is read-only"))
     return CacheLocation(None, "no writable folder: rtcli's is read-only and so is " + root, False)
+
+
+def _private_location(location: CacheLocation) -> CacheLocation:
+    """`location`, its folders made by rtcli (mode 0700) before numba makes them (with the umask's)."""
+    for folder in location.folders():
+        try:
+            make_private(folder)
+        except OSError:
+            pass                        # numba says so when it cannot write there
+    return location
 
 
 # --- the vocabulary, numpy variant (the names kernels import) ---

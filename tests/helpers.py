@@ -12,7 +12,7 @@ import textwrap
 
 import numpy as np
 
-from rtcli.render import Job, render_tile
+from rtcli.rendering.tiles import Job, render_tile
 from rtcli.scenefile import yamlfile
 from rtcli.scenefile.build import scene_from_docs
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtcli.render import Job, render
+from rtcli.rendering.tiles import Job, render
 from rtcli.wavefront.accel import Accelerator
 from rtcli.wavefront.intersect import find_first_hit, occluded, surface
 from rtcli.wavefront.rays import Rays

@@ -13,7 +13,7 @@ import yaml
 from PIL import Image
 
 import rtcli
-from rtcli.writer import to_8bit
+from rtcli.core.display import to_8bit
 
 SCENE = """\
 image: {width: 32, height: 24}
@@ -173,8 +173,8 @@ def test_diff_passes_equal_images_and_fails_a_changed_material(spec):
 
 
 def test_import_rtcli_is_cheap_and_render_stays_the_function():
-    code = ("import sys, rtcli; cheap = 'numpy' not in sys.modules; from rtcli.render import Job; "
-            "import rtcli.render; print(cheap, callable(rtcli.render) and rtcli.render.__module__)")
+    code = ("import sys, rtcli; cheap = 'numpy' not in sys.modules; from rtcli.rendering.tiles import Job; "
+            "import rtcli.rendering.tiles; print(cheap, callable(rtcli.render) and rtcli.render.__module__)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.split() == ["True", "rtcli.api"]
 

@@ -12,7 +12,7 @@ from helpers import scene_from_yaml
 
 from rtcli.core import camera as cameras
 from rtcli.errors import SceneError
-from rtcli.render import camera_rays
+from rtcli.wavefront.rays import camera_rays
 
 EYE, LOOK, UP = np.array([1.0, 2.0, 3.0]), np.array([-2.0, 0.5, -1.0]), np.array([0.2, 1.0, 0.1])
 
@@ -74,7 +74,7 @@ def test_fov_world_is_right_handed():
 
 def test_right_handed_through_a_signature():
     """Built from YAML: a sphere at +x shows in the right half, one at +y in the top half."""
-    from rtcli.render import Job, render
+    from rtcli.rendering.tiles import Job, render
     s = scene_from_yaml("""
 image: {width: 9, height: 9}
 camera: {eye: [0, 0, 5], look_at: [0, 0, 0], up: [0, 1, 0], fov: 60}
@@ -89,7 +89,7 @@ objects:
 
 def test_objects_behind_the_eye_are_not_seen():
     """Hits need t > 0: a sphere behind the camera is invisible, the same sphere in front is seen."""
-    from rtcli.render import Job, render
+    from rtcli.rendering.tiles import Job, render
     text = """
 image: {{width: 3, height: 3}}
 camera: {{eye: [0, 0, 5], look_at: [0, 0, 0], fov: 30}}

@@ -17,8 +17,9 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from rtcli import variants, writer
+from rtcli import variants
 from rtcli.cli import main
+from rtcli.rendering import writer
 
 SCENE = """\
 image: {width: 32, height: 24}

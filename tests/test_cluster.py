@@ -27,12 +27,16 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from rtcli import cluster as dask_cluster
-from rtcli import frames, runs, variants
+from rtcli import runs, variants
+from rtcli.api.loading import load_file
 from rtcli.cli import main
+from rtcli.cluster import renders, software, tasks
+from rtcli.cluster import session as sessions
+from rtcli.cluster.target import Target
 from rtcli.compiled.loading import Load
 from rtcli.errors import RtcliError
-from rtcli.render import Job, render
+from rtcli.rendering import frames
+from rtcli.rendering.tiles import Job, render
 
 distributed = pytest.importorskip("distributed")
 
@@ -88,10 +92,10 @@ def same_files(tmp_path, a: str, b: str) -> bool:
     return (tmp_path / a).read_bytes() == (tmp_path / b).read_bytes()
 
 
-@pytest.mark.parametrize("rays_per_task", [dask_cluster.RAYS_PER_TASK, 50])
+@pytest.mark.parametrize("rays_per_task", [sessions.RAYS_PER_TASK, 50])
 def test_a_still_on_the_cluster_is_the_local_render(run, tmp_path, cluster, monkeypatch, rays_per_task):
     """Tiles in groups (a few, or one tile a task) give the local render's bytes, on any frame."""
-    monkeypatch.setattr(dask_cluster, "RAYS_PER_TASK", rays_per_task)
+    monkeypatch.setattr(sessions, "RAYS_PER_TASK", rays_per_task)
     for frame in ("1", "4"):
         local = run("render", "scene.yaml", "--frame", frame, "--tile", "8", "-o", "local.png", "--stats")
         assert local.exit_code == 0, local.output
@@ -124,7 +128,7 @@ def test_frames_on_the_cluster_are_the_local_frames(run, tmp_path, cluster):
 def test_a_killed_worker_costs_time_not_correctness(run, tmp_path, cluster):
     """A worker killed (SIGKILL) after the first frame: its frames run again elsewhere, same bytes."""
     assert run("render", "scene.yaml", "-o", "local_%d.png").exit_code == 0
-    loaded = frames.load("scene.yaml", keep=True)
+    loaded = load_file("scene.yaml", keep=True)
     seq = frames.sequence(loaded.animation, "scene.yaml", "c_%d.png", None, None, None)
     with distributed.Client(cluster.scheduler_address, set_as_default=False) as client:
         pids = client.run(os.getpid)
@@ -135,7 +139,9 @@ def test_a_killed_worker_costs_time_not_correctness(run, tmp_path, cluster):
                 killed.append(pids[sorted(pids)[0]])
                 os.kill(killed[0], signal.SIGKILL)
         job = Job(36, 24)
-        frames.render_sequence(loaded, seq, job, 1, {}, False, kill_one, dask_cluster.Target(cluster.scheduler_address))
+        with renders.Reach(Target(cluster.scheduler_address)) as reach:
+            frames.render_sequence(loaded, seq, job, False, lambda todo: renders.frames(reach, loaded, todo, job, {},
+                                                                                        kill_one))
         client.wait_for_workers(2, timeout=60)
         assert killed and killed[0] not in client.run(os.getpid).values()        # the nanny started another
     for k in range(1, 7):
@@ -143,8 +149,8 @@ def test_a_killed_worker_costs_time_not_correctness(run, tmp_path, cluster):
 
 
 def test_a_worker_with_other_software_is_refused(run, tmp_path, cluster, monkeypatch):
-    ours = dict(dask_cluster.fingerprint(), numpy="0.0")
-    monkeypatch.setattr(dask_cluster, "_fingerprint", ours)
+    ours = dict(software.fingerprint(), numpy="0.0")
+    monkeypatch.setattr(software, "_fingerprint", ours)
     result = run("render", "scene.yaml", "-o", "c.png", "--cluster", cluster.scheduler_address)
     assert result.exit_code == 2
     line = result.output
@@ -155,9 +161,9 @@ def test_a_worker_with_other_software_is_refused(run, tmp_path, cluster, monkeyp
 
 
 def test_a_task_on_a_worker_refuses_a_client_with_other_software(cluster):
-    spec = {"fingerprint": dict(dask_cluster.fingerprint(), rtcli="0.0")}
+    spec = {"fingerprint": dict(software.fingerprint(), rtcli="0.0")}
     with distributed.Client(cluster.scheduler_address, set_as_default=False) as client:
-        future = client.submit(dask_cluster.frame_task, spec, {}, 1, Job(4, 4), pure=False)
+        future = client.submit(tasks.frame_task, spec, {}, 1, Job(4, 4), pure=False)
         with pytest.raises(RtcliError, match=r"runs other software \(rtcli 0.0 here, 0.1.0 \(sources"):
             future.result()
 
@@ -172,11 +178,12 @@ def test_the_local_cluster_option(run, tmp_path):
 def test_a_lost_cluster_keeps_the_frames_done_and_says_so(run, tmp_path):
     lost = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                                     dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
-    loaded = frames.load("scene.yaml", keep=True)
+    loaded = load_file("scene.yaml", keep=True)
     seq = frames.sequence(loaded.animation, "scene.yaml", "c_%d.png", None, None, None)
-    where = dask_cluster.Target(lost.scheduler_address)
-    with pytest.raises(RtcliError) as e:
-        frames.render_sequence(loaded, seq, Job(36, 24), 1, {}, False, lambda done, total: lost.close(), where)
+    job = Job(36, 24)
+    with pytest.raises(RtcliError) as e, renders.Reach(Target(lost.scheduler_address)) as reach:
+        frames.render_sequence(loaded, seq, job, False,
+                               lambda todo: renders.frames(reach, loaded, todo, job, {}, lambda done, total: lost.close()))
     assert str(e.value) == (f"lost the Dask scheduler at {lost.scheduler_address} mid-render "
                             "(FutureCancelledError); the render was stopped")
     written = sorted(p for p in os.listdir(tmp_path) if p.startswith("c_"))
@@ -225,11 +232,11 @@ def test_without_dask_the_error_names_the_extra(run, tmp_path, monkeypatch, comm
 
 def test_groups_are_about_rays_per_task_and_several_per_worker():
     tiles = [(np.arange(16), np.arange(16))] * 100                      # 256 rays a tile
-    assert sorted(len(g) for g in dask_cluster.groups(tiles, 1, 2)) == [12] * 4 + [13] * 4
-    assert sum(map(len, dask_cluster.groups(tiles, 1, 2))) == 100
+    assert sorted(len(g) for g in sessions.groups(tiles, 1, 2)) == [12] * 4 + [13] * 4
+    assert sum(map(len, sessions.groups(tiles, 1, 2))) == 100
     big = [(np.arange(128), np.arange(128))] * 400                      # 6.5 million rays
-    assert len(dask_cluster.groups(big, 1, 1)) == 4 and len(dask_cluster.groups(big, 2, 1)) == 14
-    assert len(dask_cluster.groups(tiles[:3], 1, 8)) == 3
+    assert len(sessions.groups(big, 1, 1)) == 4 and len(sessions.groups(big, 2, 1)) == 14
+    assert len(sessions.groups(tiles[:3], 1, 8)) == 3
 
 
 def test_a_scene_builds_from_the_bytes_a_load_kept(run, tmp_path, monkeypatch):
@@ -237,14 +244,14 @@ def test_a_scene_builds_from_the_bytes_a_load_kept(run, tmp_path, monkeypatch):
     the same scene; each content once in the bundle."""
     (tmp_path / "twice.yaml").write_text(SCENE.replace("parts.yaml]", "parts.yaml, copy.yaml]"))
     (tmp_path / "copy.yaml").write_text(PARTS)
-    loaded = frames.load("twice.yaml", frame=3, keep=True)
-    bundle = loaded.bundle
+    loaded = load_file("twice.yaml", frame=3, keep=True)
+    bundle = renders.bundle(loaded)
     assert sorted(os.path.basename(m[0]) for m in bundle.manifest) == \
         ["copy.yaml", "grid.png", "parts.yaml", "tri.obj", "twice.yaml"]
     assert len(bundle.blobs) == 4 and bundle.size == sum(len(b) for b in bundle.blobs.values())
     monkeypatch.chdir(tmp_path.parent)
     spec = {"key": bundle.key, "scene_path": bundle.scene_path, "manifest": bundle.manifest, "overrides": {}}
-    scene = dask_cluster._scene(spec, bundle.blobs, 3)
+    scene = tasks._scene(spec, bundle.blobs, 3)
     a, _ = render(scene, Job(36, 24))
     b, _ = render(loaded.scene, Job(36, 24))
     assert a.tobytes() == b.tobytes()
@@ -252,15 +259,16 @@ def test_a_scene_builds_from_the_bytes_a_load_kept(run, tmp_path, monkeypatch):
 
 def test_workers_keep_the_scene_they_built_between_tasks(run, tmp_path, cluster, monkeypatch):
     """Many tasks of one still: each worker holds one parsed scene and one built frame for it."""
-    monkeypatch.setattr(dask_cluster, "RAYS_PER_TASK", 50)
-    loaded = frames.load("scene.yaml", frame=2, keep=True)
-    image, _ = frames.render_image(loaded, Job(36, 24, tile=4), 1, None, dask_cluster.Target(cluster.scheduler_address))
+    monkeypatch.setattr(sessions, "RAYS_PER_TASK", 50)
+    loaded = load_file("scene.yaml", frame=2, keep=True)
+    with renders.Reach(Target(cluster.scheduler_address)) as reach:
+        image, _ = renders.still(reach, loaded, Job(36, 24, tile=4))
     assert image.tobytes() == render(loaded.scene, Job(36, 24))[0].tobytes()
-    key = loaded.bundle.key
+    key = renders.bundle(loaded).key
 
     def kept():
-        return ([k for k in dask_cluster._animations if k == key],
-                [k[1] for k in dask_cluster._scenes if k[0] == key])
+        return ([k for k in tasks._animations if k == key],
+                [k[1] for k in tasks._scenes if k[0] == key])
     with distributed.Client(cluster.scheduler_address, set_as_default=False) as client:
         for animations, scenes in client.run(kept).values():
             assert (animations, scenes) in (([key], [2]), ([], []))      # a worker that got no task keeps none
@@ -273,8 +281,8 @@ def test_a_scheduler_without_workers_is_named(run, tmp_path):
     try:
         with dask.config.set({"distributed.comm.timeouts.connect": "0.5s"}):
             with pytest.raises(RtcliError) as e:
-                frames.render_image(frames.load("scene.yaml", keep=True), Job(36, 24), 1, None,
-                                    dask_cluster.Target(empty.scheduler_address))
+                with renders.Reach(Target(empty.scheduler_address)) as reach:
+                    renders.still(reach, load_file("scene.yaml", keep=True), Job(36, 24))
         assert str(e.value) == (f"the Dask scheduler at {empty.scheduler_address} has no workers "
                                 "(start some: README.md, Clusters)")
     finally:
@@ -307,7 +315,7 @@ COMPILING = "compiling the render engine, once (about a minute); cached in /some
 def compiling(monkeypatch):
     """The engine's start-up on the `threads` workers (whose tasks give notes) replaced by one that says it compiles, waits
     until `heard` is set (at most 60 s; whether it was, in `waited`), and reports 2.5 s of compiling."""
-    rendering = sys.modules["rtcli.render"]              # the module (rtcli.render is also rtcli's function)
+    rendering = sys.modules["rtcli.rendering.tiles"]
     real, heard, waited = rendering.prepare, threading.Event(), []
 
     def prepare(scene, job, traced, notes=None):
@@ -318,7 +326,7 @@ def compiling(monkeypatch):
         engine, load = real(scene, job, traced, notes)
         return engine, (load or Load()) + Load(2.5, 2.5)
     monkeypatch.setattr(rendering, "prepare", prepare)
-    monkeypatch.setattr(dask_cluster, "_scenes", OrderedDict())       # no scene kept from another test
+    monkeypatch.setattr(tasks, "_scenes", OrderedDict())       # no scene kept from another test
     return heard, waited
 
 
@@ -333,9 +341,9 @@ def test_the_client_hears_a_worker_compile_while_the_render_runs(run, threads, c
         notes.append(text)
         if text.endswith(COMPILING):
             heard.set()
-    loaded = frames.load("scene.yaml", frame=2, keep=True)
-    with frames.Reach(dask_cluster.Target(threads.scheduler_address), note) as where:
-        image, _ = frames.render_image(loaded, Job(36, 24, tile=8), 1, None, where)
+    loaded = load_file("scene.yaml", frame=2, keep=True)
+    with renders.Reach(Target(threads.scheduler_address), note) as reach:
+        image, _ = renders.still(reach, loaded, Job(36, 24, tile=8))
     assert image.tobytes() == render(loaded.scene, Job(36, 24))[0].tobytes()
     assert waited == [True]                             # heard while the worker was still compiling
     worker = notes[0].split()[1].rstrip(":")
@@ -434,7 +442,7 @@ def test_warmup_on_local_worker_processes_reports_each(run):
 
 
 def test_warmup_refuses_a_worker_with_other_software(run, cluster, monkeypatch):
-    monkeypatch.setattr(dask_cluster, "_fingerprint", dict(dask_cluster.fingerprint(), numpy="0.0"))
+    monkeypatch.setattr(software, "_fingerprint", dict(software.fingerprint(), numpy="0.0"))
     result = run("warmup", "--cluster", cluster.scheduler_address)
     assert result.exit_code == 2 and result.output.count("\n") == 1
     assert result.output.startswith("error: the worker tcp://127.0.0.1:")

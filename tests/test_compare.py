@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from rtcli.compare import (
+from rtcli.compare.images import (
     compare,
     compare_ids,
     compare_images,

@@ -12,13 +12,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import without_avx512
 
 from rtcli import compiled as fast
 from rtcli import variants
 from rtcli.errors import RtcliError
-from rtcli.render import Job, render, render_tile
+from rtcli.rendering.tiles import Job, render, render_tile
 from rtcli.scenefile.build import load_scene
-from helpers import without_avx512
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 
@@ -464,12 +464,12 @@ def test_numpys_two_code_paths_and_both_engines_give_the_same_bytes(tmp_path):
     numpy engine in a process whose numpy has no AVX-512 paths (SVML), and here by both engines."""
     (tmp_path / "random.yaml").write_text(random_csg_scene(11, SOLIDS))
     paths = [str(ROOT / "scenes" / f"{name}.yaml") for name in CPU_SENSITIVE] + [str(tmp_path / "random.yaml")]
-    code = ("import sys, numpy as np; from rtcli.render import Job, render; from rtcli.scenefile.build import "
-            "load_scene; from rtcli.writer import to_8bit; "
+    code = ("import sys, numpy as np; from rtcli.rendering.tiles import Job, render; from rtcli.scenefile.build import "
+            "load_scene; from rtcli.core.display import to_8bit; "
             "[np.save(f'{sys.argv[1]}/{k}.npy', to_8bit(render(load_scene(p), Job(80, 60, engine='numpy'))[0], "
             "gamma=True)) for k, p in enumerate(sys.argv[2:])]")
     without_avx512(["-c", code, str(tmp_path), *paths])
-    from rtcli.writer import to_8bit
+    from rtcli.core.display import to_8bit
     for k, path in enumerate(paths):
         other = np.load(tmp_path / f"{k}.npy")
         for engine in ("numpy", "compiled"):
@@ -584,7 +584,7 @@ def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_an
     """Below AUTO_RAYS, `auto` stays on numpy for plain scenes, but a mesh (or a set of spheres)
     makes the numpy engine load compiled walks itself, so the compiled engine is taken (once
     it is cached)."""
-    from rtcli.render import prepare
+    from rtcli.rendering.tiles import prepare
     monkeypatch.setattr(fast, "ready_to_load", lambda: True)
     monkeypatch.setattr(fast, "starts_at_once", lambda: False)          # no machine code file
     small = fast.AUTO_RAYS // 2
@@ -599,7 +599,7 @@ def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_an
 def test_auto_stays_on_numpy_for_a_small_job_before_the_first_compile(monkeypatch, tmp_path):
     """Uncached, the integrator would compile for a minute where the numpy engine's walks take
     seconds: a small mesh job stays on numpy. ready_to_load reads the cache it is given."""
-    from rtcli.render import prepare
+    from rtcli.rendering.tiles import prepare
     monkeypatch.setattr(fast, "ready_to_load", lambda: False)
     monkeypatch.setattr(fast, "starts_at_once", lambda: False)
     scene = load_scene(str(ROOT / "bench/torus100k.yaml"))

@@ -19,8 +19,8 @@ from click.testing import CliRunner
 import rtcli
 from rtcli import compiled
 from rtcli.cli import main
-from rtcli.explain import Recorder
-from rtcli.render import Job, render_tile
+from rtcli.inspect.explain import Recorder
+from rtcli.rendering.tiles import Job, render_tile
 
 SCENES = sorted(str(p) for p in (Path(__file__).parent.parent / "scenes").glob("*.yaml"))
 PIXELS = 12

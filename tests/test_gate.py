@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rtcli.compare import compare_ids, compare_images
-from rtcli.render import Job, render
+from rtcli.compare.images import compare_ids, compare_images
+from rtcli.rendering.tiles import Job, render
 
 SCENE = """
 image: {{width: 160, height: 120}}

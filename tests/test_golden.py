@@ -15,10 +15,11 @@ from pathlib import Path
 
 import pytest
 
-from rtcli import compare
-from rtcli.render import Job, render
+from rtcli.compare import images as compare
+from rtcli.core.display import signature_colors
+from rtcli.rendering.tiles import Job, render
+from rtcli.rendering.writer import write_png
 from rtcli.scenefile.build import load_scene
-from rtcli.writer import signature_colors, write_png
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = sorted(p for p in (ROOT / "scenes").glob("*.yaml"))

@@ -15,9 +15,9 @@ from click.testing import CliRunner
 from helpers import scene_from_yaml
 
 import rtcli
-from rtcli import checks
-from rtcli import watch as watching
 from rtcli.cli import main
+from rtcli.inspect import checks
+from rtcli.rendering import watch as watching
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays
 
@@ -235,7 +235,7 @@ def _alone(scene, k: int):
 # --- counts ---
 def test_counts_say_1_thing_and_2_things():
     from rtcli.errors import plural
-    from rtcli.views import summary
+    from rtcli.inspect.views import summary
     assert [plural(n, "warning") for n in (0, 1, 2)] == ["0 warnings", "1 warning", "2 warnings"]
     assert plural(1, "mesh", "meshes") + ", " + plural(3, "mesh", "meshes") == "1 mesh, 3 meshes"
     assert summary(np.array([[np.inf, 2.0]]), "depth").endswith("; 1 pixel misses (black)")

@@ -3,6 +3,7 @@ numba's numbers, and a file is used only by a process it was made for."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import shutil
@@ -17,7 +18,7 @@ import pytest
 from rtcli import compiled as fast
 from rtcli import machinecode, variants
 from rtcli.core import bvh_build
-from rtcli.render import Job, render_tile
+from rtcli.rendering.tiles import Job, render_tile
 from rtcli.scenefile.build import load_scene
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
@@ -117,14 +118,32 @@ def test_the_cpu_is_told_by_its_model_and_flags():
         assert machinecode.cpu().startswith("cpuinfo ")                    # read, not the fallback
 
 
-def test_a_library_with_a_symbol_the_process_lacks_is_not_used(small, place, tmp_path):
+def put_library(place, name, code: bytes, **changes) -> Path:
+    """Put `code` in place as the library of `name`, its description naming it with its SHA-256
+    (a pair as make writes it), then `changes` to the description."""
+    library = place / f"rtcli-{name}-{hashlib.sha256(code).hexdigest()[:16]}.so"
+    library.write_bytes(code)
+    edit_description(place, name, lambda d: d.update(library=library.name, sha256=hashlib.sha256(code).hexdigest(),
+                                                      **changes))
+    return library
+
+
+@pytest.fixture
+def build(tmp_path_factory):
+    """compile(source): a shared library compiled from C source by the C compiler, as bytes."""
+    def compile_c(source: str) -> bytes:
+        work = tmp_path_factory.mktemp("c")
+        c, library = work / "library.c", work / "library.so"
+        c.write_text(source)
+        subprocess.run([*machinecode.compiler(), "-shared", "-fPIC", "-o", str(library), str(c)], check=True)
+        return library.read_bytes()
+    return compile_c
+
+
+def test_a_library_with_a_symbol_the_process_lacks_is_not_used(small, place, build):
     """Opened with every symbol bound: one the process does not have means numba's path."""
-    cc = machinecode.compiler()
-    source = tmp_path / "lacks.c"
-    source.write_text("extern void rtcli_no_such_symbol(void);\nvoid lacks(void) { rtcli_no_such_symbol(); }\n")
-    library = place / "rtcli-small-lacks.so"
-    subprocess.run([*cc, "-shared", "-fPIC", "-o", str(library), str(source)], check=True)
-    edit_description(place, "small", lambda d: d.update(library=library.name, symbol="lacks"))
+    put_library(place, "small", build("extern void rtcli_no_such_symbol(void);\n"
+                                      "int rtcli_entry(void) { rtcli_no_such_symbol(); return 0; }\n"))
     assert machinecode.load("small") is None
 
 
@@ -139,6 +158,208 @@ def test_a_missing_or_broken_file_is_not_used(small, place):
     machinecode._loaded.clear()
     assert machinecode.load("small") is None
     assert machinecode.load("never-made") is None
+
+
+# --- trust: a file is opened only when this user wrote it (docs/architecture.md) ---
+PLANTED = """#include <stdio.h>
+__attribute__((constructor)) static void planted(void) {{
+    FILE *f = fopen("{marker}", "w");
+    if (f) {{ fputs("ran", f); fclose(f); }}
+}}
+int rtcli_entry(void *words, void *floats, void *results) {{ return 0; }}
+"""
+
+
+@pytest.fixture
+def planted(small, build, tmp_path_factory):
+    """A library whose constructor, run when it is opened, writes a marker file: (its bytes, the marker)."""
+    marker = tmp_path_factory.mktemp("marker") / "ran"
+    return build(PLANTED.format(marker=marker)), marker
+
+
+@pytest.fixture
+def notes():
+    """What load says about the files it does not use."""
+    heard = []
+    machinecode.report_to(heard.append)
+    machinecode._told.clear()
+    yield heard
+    machinecode.report_to(None)
+
+
+def test_a_planted_library_runs_only_when_every_check_passes(place, planted):
+    """The marker works: a library this user wrote and recorded is opened, constructor and all
+    (so the tests below, where it never appears, can fail)."""
+    code, marker = planted
+    put_library(place, "small", code)
+    assert machinecode.load("small") is not None and marker.read_text() == "ran"
+
+
+def test_a_library_planted_under_the_expected_name_never_runs(place, planted, notes):
+    code, marker = planted
+    library = place / json.loads(machinecode.description_file("small", place).read_text())["library"]
+    library.write_bytes(code)
+    assert machinecode.load("small") is None and not marker.exists()
+    assert notes == [(f"machine code file not used, numba's path instead: {library.name} does not have the "
+                      "SHA-256 recorded when it was written")]
+
+
+def chown(path, uid=65534):
+    os.chown(path, uid, uid, follow_symlinks=False)
+
+
+def moved_away(path):
+    """`path` replaced by a link to the same bytes elsewhere."""
+    away = path.parent.parent / f"away-{path.name}"
+    path.rename(away)
+    path.symlink_to(away)
+
+
+OTHERS = {                    # what is done to the library, its description or their folder; what load says
+    "library of another user": (lambda lib, about, place: chown(lib), "belongs to another user (uid 65534)"),
+    "library writable by others": (lambda lib, about, place: lib.chmod(0o666), "is writable by other users"),
+    "library writable by its group": (lambda lib, about, place: lib.chmod(0o664), "is writable by other users"),
+    "description of another user": (lambda lib, about, place: chown(about), "belongs to another user"),
+    "description writable by others": (lambda lib, about, place: about.chmod(0o646), "is writable by other users"),
+    "folder of another user": (lambda lib, about, place: chown(place), "belongs to another user"),
+    "folder writable by others": (lambda lib, about, place: place.chmod(0o777), "is writable by other users"),
+    "folder writable by its group": (lambda lib, about, place: place.chmod(0o770), "is writable by other users"),
+    "library a link": (lambda lib, about, place: moved_away(lib), "is not a regular file"),
+    "description a link": (lambda lib, about, place: moved_away(about), "is not a regular file"),
+}
+
+
+@pytest.mark.parametrize("case", OTHERS)
+def test_a_file_anyone_else_could_have_written_is_never_opened(place, planted, notes, case):
+    """Even with the SHA-256 of its description: the owner, the modes and the kind of file are
+    checked first, and the constructor never runs."""
+    code, marker = planted
+    library = put_library(place, "small", code)
+    change, said = OTHERS[case]
+    change(library, machinecode.description_file("small", place), place)
+    assert machinecode.load("small") is None and not marker.exists()
+    assert len(notes) == 1 and said in notes[0], notes
+
+
+def test_without_memory_files_a_private_copy_is_opened_and_removed(small, monkeypatch, tmp_path_factory):
+    """Where there is no memfd (macOS), the checked bytes are opened from a copy in a new 0700
+    folder, removed once open."""
+    monkeypatch.delattr(os, "memfd_create")
+    private = tmp_path_factory.mktemp("tmp")
+    monkeypatch.setattr(machinecode.tempfile, "tempdir", str(private))
+    kept = len(machinecode._kept)
+    assert machinecode.load("small")(*small_args()) == (4, 4)
+    assert len(machinecode._kept) == kept and list(private.iterdir()) == []
+
+
+def test_a_folder_that_is_a_link_to_this_users_folder_is_followed(small, place, tmp_path_factory):
+    """The cache folder may be reached through a link (NUMBA_CACHE_DIR often is one): what is
+    checked is the folder it leads to."""
+    link = tmp_path_factory.mktemp("link") / "cache"
+    link.symlink_to(place)
+    machinecode.folder = lambda: link
+    machinecode._loaded.clear()
+    assert machinecode.load("small")(*small_args()) == (4, 4)
+
+
+LOAD_ALONE = """
+import sys
+from pathlib import Path
+from rtcli import machinecode
+machinecode.folder = lambda: Path(sys.argv[1])
+machinecode.report_to(print)
+print(machinecode.load("small"))
+"""
+
+
+def load_alone(place) -> list[str]:
+    """What load prints in a process of its own, which a crash or a hang cannot take the tests with."""
+    done = subprocess.run([sys.executable, "-c", LOAD_ALONE, str(place)], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT, check=False)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.splitlines()
+
+
+def test_a_truncated_or_corrupted_library_never_crashes(small, place):
+    """Cut in half (SIGBUS when mapped), with or without its description's SHA-256 updated, or a
+    byte changed: never opened."""
+    library = place / json.loads(machinecode.description_file("small", place).read_text())["library"]
+    code = library.read_bytes()
+    library.write_bytes(code[:len(code) // 2])
+    assert load_alone(place)[-1:] == ["None"]
+    put_library(place, "small", code[:len(code) // 2])
+    lines = load_alone(place)
+    assert lines[-1] == "None" and lines[0].endswith("is cut short")
+    put_library(place, "small", code[:40])
+    assert load_alone(place)[0].endswith("is cut short")
+    changed = bytearray(code)
+    changed[len(code) // 2] ^= 0xFF
+    library.write_bytes(bytes(changed))
+    edit_description(place, "small", lambda d: d.update(library=library.name, sha256=hashlib.sha256(code).hexdigest()))
+    lines = load_alone(place)
+    assert lines == [(f"machine code file not used, numba's path instead: {library.name} does not have the "
+                      "SHA-256 recorded when it was written"), "None"]
+    assert machinecode.cut_short(code) is False
+
+
+@pytest.mark.parametrize("which", ["library", "description"])
+def test_a_fifo_in_place_of_a_file_does_not_hang(small, place, which):
+    about = machinecode.description_file("small", place)
+    target = place / json.loads(about.read_text())["library"] if which == "library" else about
+    target.unlink()
+    os.mkfifo(target)
+    lines = load_alone(place)                   # within load_alone's timeout
+    assert lines == [f"machine code file not used, numba's path instead: {target.name} is not a regular file",
+                     "None"]
+    with pytest.raises(OSError):                # and no one left reading it
+        os.close(os.open(target, os.O_WRONLY | os.O_NONBLOCK))
+
+
+@pytest.mark.parametrize("symbol", ["numba_do_raise", "NRT_MemInfo_alloc", "NRT_decref", "abort",
+                                    machinecode.BODY_SYMBOL])
+def test_a_description_naming_a_helper_as_its_entry_is_refused(small, place, notes, symbol):
+    """Only rtcli's C function is ever called: not one of numba's helpers (or their stubs), nor a
+    function of the C library the library links to."""
+    edit_description(place, "small", lambda d: d.update(symbol=symbol))
+    assert machinecode.load("small") is None
+    assert notes == [(f"machine code file not used, numba's path instead: rtcli-small.json names {symbol!r} as "
+                      f"its entry, not {machinecode.ENTRY_SYMBOL}")]
+
+
+def test_the_files_are_written_for_this_user_alone_whatever_the_umask(place):
+    from numba import njit
+    body = njit(small_body)
+    body(*small_args())
+    old = os.umask(0o002)
+    try:
+        assert machinecode.make("small", body, small_args(), results=2) is None
+    finally:
+        os.umask(old)
+    for f in place.glob("rtcli-small*"):
+        assert f.stat().st_mode & 0o777 == 0o644, f
+    assert machinecode.load("small")(*small_args()) == (4, 4)
+
+
+def test_nothing_is_written_to_a_folder_anyone_else_could_write(place):
+    from numba import njit
+    body = njit(small_body)
+    body(*small_args())
+    place.chmod(0o777)
+    assert "is writable by other users" in machinecode.make("small", body, small_args(), results=2)
+    assert not list(place.iterdir())
+
+
+def test_rtcli_makes_its_cache_folders_for_this_user_alone(tmp_path):
+    old = os.umask(0o002)
+    try:
+        root = tmp_path / "cache" / "rtcli"
+        assert variants.writable(str(root))
+        location = variants._private_location(variants.CacheLocation(str(root), "test"))
+    finally:
+        os.umask(old)
+    made = [tmp_path / "cache", root, *map(Path, location.folders())]
+    assert [f.stat().st_mode & 0o777 for f in made] == [0o700] * len(made)
+    assert tmp_path.stat().st_mode & 0o777 == 0o700        # pytest's, left as it was
 
 
 def test_without_a_cache_a_c_compiler_or_the_switch_nothing_is_made(monkeypatch, place):
@@ -191,18 +412,142 @@ raising(*args)
 assert machinecode.make("raising", raising, args, results=2) is None
 del sys.modules["numba"]
 entry = machinecode.load("raising")
-entry(*args)
-print("fine", flush=True)
-entry(args[0], args[1], 9, 0.5, True)
-print("not reached", flush=True)
+print(entry(*args), flush=True)
+try:
+    entry(args[0], args[1], 9, 0.5, True)
+except machinecode.Stopped as e:
+    print("stopped:", e, flush=True)
+print(entry(*args), args[1][0], flush=True)
 """
 
 
-def test_the_error_path_says_so_and_stops_the_process(place):
+def test_the_error_path_stops_the_call_not_the_process(place):
+    """The helpers on numba's error paths are stubs that leave the machine code at once: the call
+    raises Stopped in Python, and the process (a Jupyter kernel, a Dask worker) goes on."""
     code = ERROR_PATH.format(here=str(Path(__file__).parent), place=str(place))
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT)
-    assert done.stdout.split() == ["fine"], done.stderr
-    assert done.returncode != 0 and "RTCLI_MACHINE_CODE=0" in done.stderr
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT,
+                          check=False)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[0] == "(0, 0)" and lines[2] == "(0, 0) 0.5", done.stdout
+    assert lines[1].startswith("stopped: ") and "RTCLI_MACHINE_CODE=0" in lines[1]
+
+
+def allocating(pair, out, k, x, flag):
+    scratch = np.empty(k)                   # numba's runtime allocates it, on every call
+    scratch[:] = x
+    out[0] = scratch.sum()
+    return 0, 0
+
+
+def printing(pair, out, k, x, flag):
+    if flag:
+        print(k)                            # Python's C API, on a path that raises nothing
+    return 0, 0
+
+
+@pytest.mark.parametrize("body, helper", [(allocating, "NRT_MemInfo_alloc"), (printing, "numba_gil_ensure")])
+def test_a_library_that_would_call_numbas_helpers_is_refused_when_written(place, body, helper):
+    from numba import njit
+    compiled = njit(body)
+    compiled(*small_args())
+    why = machinecode.make("small", compiled, small_args(), results=2)
+    assert why.startswith(f"refused: it would call {helper}") and f"{body.__name__}" in why
+    assert not list(place.iterdir())                               # nothing written
+
+
+# --- which helpers a call can reach: helper_calls on small modules ---
+MODULE = """
+define i32 @raiser(ptr %retptr, ptr %excinfo) {{
+entry:
+  %p = call ptr @NRT_MemInfo_alloc(i64 8)
+  {raiser_returns}
+}}
+
+define {inner_range} i32 @inner(ptr %retptr, ptr %excinfo, i64 %k) {{
+entry:
+  %c = icmp sgt i64 %k, 5
+  br i1 %c, label %bad, label %good
+
+bad:                                              ; preds = %entry
+  %s = call i32 @raiser(ptr %retptr, ptr %excinfo)
+  br label %common.ret
+
+good:                                             ; preds = %entry
+  {good}
+  br label %common.ret
+
+common.ret:                                       ; preds = %good, %bad
+  %status = phi i32 [ {bad_status}, %bad ], [ 0, %good ]
+  ret i32 %status
+}}
+
+define ptr @root(i64 %k) {{
+entry:
+  %r = alloca ptr, align 8
+  %e = alloca ptr, align 8
+  %s = call i32 @inner(ptr %r, ptr %e, i64 %k)
+  {check}
+
+failed:                                           ; preds = %entry
+  call void @numba_gil_ensure(ptr nonnull %r)
+  call void @PyErr_SetString(ptr @PyExc_RuntimeError, ptr null)
+  br label %done
+
+done:                                             ; preds = %entry, %failed
+  ret ptr null
+}}
+
+declare ptr @NRT_MemInfo_alloc(i64) local_unnamed_addr
+declare void @numba_gil_ensure(ptr) local_unnamed_addr
+declare void @PyErr_SetString(ptr, ptr) local_unnamed_addr
+@PyExc_RuntimeError = external global i8
+"""
+RAISING = {"raiser_returns": "ret i32 1", "inner_range": "range(i32 -1, -2)", "good": "%x = add i64 %k, 1",
+           "bad_status": "1", "check": "%ok = icmp eq i32 %s, 0\n  br i1 %ok, label %done, label %failed, !prof !0"}
+SWITCH = "switch i32 %s, label %failed [\n    i32 0, label %done\n{more}  ]"
+
+
+GIL_ENSURE = [("root", "numba_gil_ensure"), ("root", "PyErr_SetString"), ("root", "PyExc_RuntimeError")]
+
+
+@pytest.mark.parametrize("change, found", [
+    ({}, []),
+    ({"bad_status": "%s"}, []),                                # the raiser's status passed on as it is
+    ({"good": "%q = call ptr @NRT_MemInfo_alloc(i64 8)"}, [("inner", "NRT_MemInfo_alloc")]),     # on every call
+    ({"raiser_returns": "ret i32 0", "bad_status": "%s"}, [("raiser", "NRT_MemInfo_alloc")]),   # it returns: no error
+    ({"bad_status": "0"}, [("raiser", "NRT_MemInfo_alloc")]),    # the raiser's error swallowed: the call goes on
+    ({"inner_range": ""}, GIL_ENSURE + [("raiser", "NRT_MemInfo_alloc")]),   # -2 (None returned) may fail that test
+    ({"check": RAISING["check"].replace("eq", "ne")}, GIL_ENSURE),  # the branch of a call that returned
+    ({"inner_range": "", "check": SWITCH.format(more="    i32 -2, label %done\n")}, []),     # numba's own test
+    ({"check": SWITCH.format(more="")}, []),                        # -2 cannot be: LLVM's range says so
+    ({"inner_range": "", "check": SWITCH.format(more="")}, GIL_ENSURE + [("raiser", "NRT_MemInfo_alloc")]),
+])
+def test_helper_calls_are_found_on_the_paths_that_raise_nothing(change, found):
+    """numba's helpers may lie where a call raises (the blocks that only return an error status,
+    or that a failed call's status leads to), nowhere else."""
+    assert machinecode.helper_calls(MODULE.format(**{**RAISING, **change}), "root") == found
+
+
+def test_the_engines_modules_call_numbas_helpers_only_where_they_raise(engine_files):
+    """The integrator's and the BVH build's modules (made by numba now, as make does) reach numba's
+    helpers and Python's only on paths that raise, and do reference them there."""
+    from rtcli.compiled.warmup import _scenes
+    engine = fast.choose(_scenes()[0], "compiled", notes=lambda text: None)
+    lo = np.random.default_rng(0).random((64, 3))
+    levels = variants.compiled(bvh_build.levels)
+    for name, body, args, results in [(fast.ENTRY, fast._trace_camera(), engine.empty_call, 0),
+                                      (bvh_build.LEVELS, levels, bvh_build.levels_args(lo, lo + 0.1, 2, 12), 2)]:
+        _, module = machinecode._module(name, body, args, results)
+        text = str(module)
+        assert machinecode.helper_calls(text, machinecode.BODY_SYMBOL) == [], name
+        functions, variables = machinecode.foreign_symbols(text)
+        assert {"numba_gil_ensure", "numba_do_raise"} <= set(functions) and "PyExc_RuntimeError" in variables, name
+
+
+def test_numba_symbols_read_as_python_names():
+    assert machinecode.readable("_ZN5rtcli6shapes7polygon3hitB4v129B46c8tJTIeFI") == "rtcli.shapes.polygon.hit"
+    assert machinecode.readable("NRT_decref") == "NRT_decref"
 
 
 def test_the_wrapper_rebuilds_each_kind_of_argument():

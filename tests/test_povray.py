@@ -19,7 +19,7 @@ import pytest
 from PIL import Image
 from scipy import ndimage
 
-from rtcli.render import Job, render
+from rtcli.rendering.tiles import Job, render
 from rtcli.scenefile.build import load_scene
 
 DATA = Path(__file__).resolve().parent / "data" / "povray"

@@ -21,13 +21,14 @@ from PIL import Image
 from preview_helpers import GREEN, LOOK, Page, Preview, read_page, save, write_scene
 
 import rtcli
-from rtcli import variants, views
+from rtcli import variants
+from rtcli.inspect import views
 from rtcli.cli import main
 from rtcli.preview import server
 from rtcli.preview.against import flip_installed
 from rtcli.preview.passes import Progressive, passes
-from rtcli.render import Job
-from rtcli.watch import Changes
+from rtcli.rendering.tiles import Job
+from rtcli.rendering.watch import Changes
 
 aiohttp = pytest.importorskip("aiohttp", reason="rtcli preview needs the extra `preview`")
 
@@ -74,7 +75,7 @@ def test_changes_are_taken_once_they_hold_still(tmp_path):
     path = tmp_path / "a.yaml"
     path.write_text("one")
     from rtcli.scenefile.reuse import Kept
-    from rtcli.watch import recording
+    from rtcli.rendering.watch import recording
     with recording(str(path), Kept()) as seen:
         pass
     changes = Changes(seen)
@@ -210,7 +211,7 @@ def test_preview_serves_the_render_explains_it_and_streams_it_to_tev(tmp_path):
 
         # the debug views: the picture and the summary rtcli.view gives
         for kind in ("normal", "depth", "ids"):
-            data = views.view(scene, kind)
+            data = rtcli.view(scene, kind)
             _, _, png = http(preview, f"view/{kind}.png")
             np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(png)).convert("RGB")),
                                           views.picture(np.asarray(data), kind, 5))
@@ -235,7 +236,7 @@ def test_preview_serves_the_render_explains_it_and_streams_it_to_tev(tmp_path):
         channels = tev_images[name]["channels"]
         linear = np.asarray(rtcli.render(scene, linear=True), np.float32)
         np.testing.assert_array_equal(np.dstack([channels[c] for c in "RGB"]), linear)
-        depth = np.asarray(views.view(scene, "depth"))
+        depth = np.asarray(rtcli.view(scene, "depth"))
         np.testing.assert_array_equal(channels["depth.Y"], np.where(np.isfinite(depth), depth, 0).astype(np.float32))
         np.testing.assert_array_equal(channels["ids.Y"], np.asarray(rtcli.signature(scene), np.float32))
 

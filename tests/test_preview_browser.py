@@ -19,7 +19,7 @@ from PIL import Image
 from preview_helpers import DEADLINE, GREEN, LOOK, Preview, save, write_scene
 
 import rtcli
-from rtcli import views
+from rtcli.inspect import views
 from rtcli.cli import main
 from rtcli.preview.against import flip_installed
 
@@ -131,7 +131,7 @@ def test_a_user_s_session_in_the_browser(tmp_path, browser, monkeypatch):
         # the views: each the picture and summary of rtcli.view
         for kind in ("normal", "bounces"):
             page.click(f"[data-view={kind}]")
-            data = np.asarray(views.view(scene, kind))
+            data = np.asarray(rtcli.view(scene, kind))
             page.wait_for_function(f"() => document.getElementById('summary').textContent === "
                                    f"{json.dumps(views.summary(data, kind, 5))}")
             page.wait_for_function("() => { const p = document.getElementById('picture'); "

@@ -1,4 +1,4 @@
-"""rtcli.render: block-size preview, tiles and workers, samples, signatures.
+"""rtcli.rendering.tiles: block-size preview, tiles and workers, samples, signatures.
 
 A pixel's value depends only on the pixel, so tile size and worker count never
 change a byte of the image; a preview block is its top-left pixel repeated.
@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from helpers import scene_from_yaml
 
-from rtcli.render import Job, render, sample_positions
+from rtcli.core.jitter import sample_positions
+from rtcli.rendering.tiles import Job, render
 
 W, H = 23, 17                       # not multiples of the block or tile sizes
 
@@ -101,8 +102,9 @@ def test_samples_2_is_close_different_and_deterministic(reference):
 
 def test_a_pixel_is_the_mean_of_its_samples():
     """With samples n, a pixel's float color is the mean of the n x n rays traced at sample_positions."""
-    from rtcli.render import camera_rays, render_tile
+    from rtcli.rendering.tiles import render_tile
     from rtcli.stats import Stats
+    from rtcli.wavefront.rays import camera_rays
     from rtcli.wavefront.trace import trace
     scene2 = scene_from_yaml(SCENE.format(samples=2))
     i, j = np.array([3, 11, 20, 7]), np.array([2, 8, 15, 12])
@@ -146,7 +148,7 @@ def test_signature_is_the_same_for_any_tiling():
 
 def test_tiles_shrink_with_samples_so_rays_per_tile_stay_bounded():
     """n x n samples per pixel: tiles n times narrower, about tile^2 rays each."""
-    from rtcli.render import _tiles
+    from rtcli.rendering.tiles import _tiles
     job = Job(256, 256, tile=128)
     assert max(len(r) * len(c) for r, c in _tiles(job, 1)) == 128 * 128
     assert max(len(r) * len(c) for r, c in _tiles(job, 4)) * 16 == 128 * 128

@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 from helpers import one_pixel, scene_from_yaml
 
-from rtcli.render import camera_rays
 from rtcli.wavefront.intersect import find_first_hit
+from rtcli.wavefront.rays import camera_rays
 
 RTOL = 1e-9
 COS30, COS60, COS15 = np.cos(np.radians(30)), 0.5, np.cos(np.radians(15))

@@ -21,7 +21,7 @@ import pytest
 from helpers import scene_from_yaml
 
 from rtcli.errors import Interrupted
-from rtcli.render import Job, render
+from rtcli.rendering.tiles import Job, render
 
 pytestmark = pytest.mark.skipif(not os.path.exists("/proc/self/task"), reason="needs Linux's /proc")
 

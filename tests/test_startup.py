@@ -118,7 +118,7 @@ def test_a_render_that_compiles_says_so_and_keeps_it_out_of_the_render_time(warm
 
 
 def test_the_stats_line_puts_compiling_apart():
-    from rtcli.results import RenderStats
+    from rtcli.api.results import RenderStats
     stats = RenderStats(8, 8, 1, "compiled", 64, 10, 0, 0, 0.5, 41.0, 40.2)
     assert stats.line().endswith(", 74 total; compiled engine; 0.50 s; 148 rays/s; 41.00 s more to compile "
                                  "the engine (once: it is cached)")
@@ -266,7 +266,7 @@ def test_after_warmup_no_scene_compiles_anything(warm, monkeypatch):
     the integrator's machine code file, and through numba there is one machine code each."""
     from rtcli.compiled import query
     from rtcli.compiled.integrator import trace_camera
-    from rtcli.render import Job, render
+    from rtcli.rendering.tiles import Job, render
     from rtcli.scenefile.build import load_scene
     scenes = [load_scene(str(p)) for p in sorted((ROOT / "scenes").glob("*.yaml")) +
               sorted((ROOT / "bench").glob("*.yaml"))]

@@ -21,11 +21,11 @@ from click.testing import CliRunner
 from PIL import Image
 
 from rtcli import api
-from rtcli import watch as watching
 from rtcli.cli import main
 from rtcli.errors import SceneError
+from rtcli.rendering import watch as watching
+from rtcli.rendering.watch import watch
 from rtcli.scenefile.reuse import Kept, reusing
-from rtcli.watch import watch
 
 SCENE = """\
 include: [mat.yaml]

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from rtcli.core.display import palette, srgb_encode, to_8bit
 from rtcli.errors import RtcliError
-from rtcli.writer import palette, srgb_encode, to_8bit, write_png
+from rtcli.rendering.writer import write_png
 
 
 def test_to_8bit_clamps_and_rounds():

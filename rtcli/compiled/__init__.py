@@ -20,7 +20,7 @@ Loading numba and its cached code takes about 0.5 s, more than the numpy engine 
 for a small image, so without a machine code file `auto` takes the compiled engine only
 from AUTO_RAYS primary rays up (a 1280x800 image, or 640x480 with --samples 2), and for
 any size when the numpy engine would load compiled BVH walks itself (meshes, sets of
-spheres) and the integrator's code is already cached (rtcli/render.py). With the file,
+spheres) and the integrator's code is already cached (rtcli/rendering/tiles.py). With the file,
 it starts at once, and `auto` takes it for any size.
 """
 

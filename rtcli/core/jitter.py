@@ -49,3 +49,18 @@ def hash_point(x, y, z, cell, axis):
     """Jitter of cell `cell` along `axis` seen from the point (x, y, z), in [0, 1)."""
     h = absorb(absorb(absorb(GOLDEN, bits(x)), bits(y)), bits(z))
     return to_unit(absorb(absorb(h, u64(cell)), u64(axis)))
+
+
+def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n x n stratified, jittered sample positions per pixel, shape (n*n, len(i)) each.
+
+    With n = 1 the single sample is the pixel centre (i + 0.5, j + 0.5).
+    """
+    if n == 1:
+        return (i + 0.5)[None, :], (j + 0.5)[None, :]
+    xs, ys = [], []
+    for cell in range(n * n):
+        a, b = divmod(cell, n)
+        xs.append(i + (b + hash_pixel(i, j, cell, 0)) / n)
+        ys.append(j + (a + hash_pixel(i, j, cell, 1)) / n)
+    return np.array(xs), np.array(ys)

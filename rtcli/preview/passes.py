@@ -7,9 +7,9 @@ whole block its color, as `rtcli render --block-size B` does. The passes go B = 
 three quarters of its grid. Every pixel is traced once in all (W x H rays, as a plain
 render), and after pass B the image is, byte for byte, the one `--block-size B` renders.
 
-The passes are cut into tiles of about TILE_RAYS rays (render.py's tiles are bigger: here a
-tile is what a new edit waits for before the render stops), each traced by render.py's
-render_tile with the engine render.prepare picked, and handed on as soon as it is done.
+The passes are cut into tiles of about TILE_RAYS rays (rendering/tiles.py's tiles are bigger: here a
+tile is what a new edit waits for before the render stops), each traced by rendering/tiles.py's
+render_tile with the engine tiles.prepare picked, and handed on as soon as it is done.
 The compiled engine traces a pass's tiles in several threads at once (Progressive).
 """
 
@@ -24,9 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.render import Job, blank, place, prepare, render_tile
+from rtcli.core.display import to_8bit
+from rtcli.rendering.tiles import Job, blank, place, prepare, render_tile
 from rtcli.stats import Stats
-from rtcli.writer import to_8bit
 
 PASSES = (16, 8, 4, 2, 1)          # one ray per B x B block, pass by pass
 TILE_RAYS = 4096                   # rays per tile, about (a tile's edge: 64 grid points at one sample)

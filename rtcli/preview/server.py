@@ -251,7 +251,7 @@ class Preview:
 
     async def image(self, request: web.Request) -> web.Response:
         """The picture as it is now."""
-        from rtcli.results import png_bytes
+        from rtcli.api.results import png_bytes
         image = self.session.image
         if image is None:
             raise web.HTTPNotFound(text="404: nothing rendered yet\n")

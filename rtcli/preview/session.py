@@ -1,7 +1,7 @@
 """The scene a preview shows: loaded, rendered pass by pass, watched, and asked about.
 
 One thread owns the scene (the model, its engine, its BVH are not shared): it loads the
-scene file as `rtcli render --watch` does (watch.py: the stamps of every file read, meshes
+scene file as `rtcli render --watch` does (rendering/watch.py: the stamps of every file read, meshes
 kept from one load to the next), renders it pass by pass (passes.py), and between two tiles
 answers what the pages ask (a pixel's explanation, a debug view, another frame) and looks
 at the files. A save stops the render after the tile at hand and starts the next one; a
@@ -27,8 +27,8 @@ import numpy as np
 from rtcli.errors import RtcliError, error_line, one_line, plural, shown
 from rtcli.preview import messages
 from rtcli.preview.passes import Progressive, passes
-from rtcli.views import KINDS as VIEWS
-from rtcli.watch import Changes, recording
+from rtcli.inspect.views import KINDS as VIEWS
+from rtcli.rendering.watch import Changes, recording
 
 POLL = 0.05                        # seconds between looks at the scene's files
 MAX_IDS = 65535                    # objects a signature's 16-bit ids tell apart (api.check_ids)
@@ -124,14 +124,13 @@ class Session:
 
     def _load(self) -> None:
         """Load the scene file, recording what it reads; publish the error of a broken one."""
-        from rtcli.frames import load
-        from rtcli.lint import lines
-        from rtcli.scene_api import of_loaded
+        from rtcli.api.loading import load_file, of_loaded
+        from rtcli.inspect.lint import lines
         self._reload = False
         o = self.options
         with recording(self.path, self._kept) as seen:
             try:
-                loaded = load(self.path, None, lint=True)
+                loaded = load_file(self.path, None, lint=True)
                 base = of_loaded(loaded, self.path).override(o.width, o.height, o.samples, o.max_depth)
                 if self.frame > base.frames:
                     self.say(f"note: frame {self.frame}: {shown(self.path)} has {plural(base.frames, 'frame')}; "
@@ -161,7 +160,7 @@ class Session:
     def _render(self) -> None:
         """Render the scene in hand pass by pass; return early when a file changes, another frame
         is asked for, or the preview stops."""
-        from rtcli.render import Job
+        from rtcli.rendering.tiles import Job
         self._rerender, o, scene = False, self.options, self.scene
         self.render += 1
         self.views, self.done, self.compare, self.progress = {}, None, None, None
@@ -214,7 +213,7 @@ class Session:
 
     def _finish(self, run: Progressive) -> None:
         """The render is done: its stats, the golden comparison, tev's channels."""
-        from rtcli.results import RenderStats
+        from rtcli.api.results import RenderStats
         s, scene = run.stats, self.scene
         stats = RenderStats.of(scene.width, scene.height, scene.model.settings.samples, s, run.progress.seconds,
                                start_up=False)
@@ -236,7 +235,7 @@ class Session:
         return name if self.base.frames == 1 else f"{name} frame {self.frame}"
 
     def _scene_info(self, scene) -> dict:
-        from rtcli.checks import object_rows
+        from rtcli.inspect.checks import object_rows
         return {"type": "scene", "render": self.render, "name": shown(self.path), "title": self._title(),
                 "width": scene.width, "height": scene.height, "frame": self.frame, "frames": self.base.frames,
                 "samples": scene.model.settings.samples, "warnings": self.warnings,
@@ -274,26 +273,26 @@ class Session:
 
     def _explain(self, x: int, y: int) -> tuple[str, str]:
         """Pixel (x, y) of the frame shown explained: `rtcli explain --json`'s text, and its tree as
-        `rtcli explain` prints it (explain.py)."""
-        from rtcli.explain import explain
+        `rtcli explain` prints it (rtcli/inspect/explain.py)."""
+        from rtcli.api import explain
         if self.scene is None:
             raise RtcliError("the scene has not loaded: nothing to explain")
         e = explain(self.scene, x, y, gamma=self.options.gamma, bvh=self.options.bvh)
         return e.json(), e.text(0)
 
     def _view(self, kind: str) -> tuple[np.ndarray, str, bytes]:
-        """(data, summary, PNG) of the debug view `kind` of the frame shown (views.py)."""
-        from rtcli import views
-        from rtcli.results import png_bytes
+        """(data, summary, PNG) of the debug view `kind` of the frame shown (rtcli/inspect/views.py)."""
+        from rtcli.api import view
+        from rtcli.api.results import png_bytes
+        from rtcli.inspect.views import picture, summary
         if self.scene is None:
             raise RtcliError("the scene has not loaded: no view to show")
         if kind not in VIEWS:
             raise RtcliError(f"the view must be one of {', '.join(VIEWS)}, got {one_line(kind)!r}")
         if kind not in self.views:
             max_depth = self.scene.model.settings.max_depth
-            data = self.ids if kind == "ids" and self.ids is not None else np.asarray(views.view(self.scene, kind))
-            self.views[kind] = (data, views.summary(data, kind, max_depth),
-                                png_bytes(views.picture(data, kind, max_depth)))
+            data = self.ids if kind == "ids" and self.ids is not None else np.asarray(view(self.scene, kind))
+            self.views[kind] = (data, summary(data, kind, max_depth), png_bytes(picture(data, kind, max_depth)))
         return self.views[kind]
 
     def _frame(self, k: int) -> int:

@@ -13,10 +13,10 @@ import numpy as np
 
 from rtcli.core import camera as cameras
 from rtcli.core.elementary import cos
-from rtcli.core.vec import unit3
 from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, Settings
+from rtcli.core.vec import unit3
 from rtcli.errors import SceneError, plural
 from rtcli.scenefile import remarks, yamlfile
 from rtcli.scenefile.files import reading_scene

@@ -1,10 +1,13 @@
-"""Rays in arrays: a wavefront of n rays S + t c, stored as components (3, n)."""
+"""Rays in arrays: a wavefront of n rays S + t c, stored as components (3, n); the camera's rays
+through arrays of image positions."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+
+from rtcli.core.camera import primary_ray
 
 
 @dataclass(frozen=True)
@@ -26,3 +29,9 @@ class Rays:
 
     def at(self, t: np.ndarray) -> np.ndarray:
         return self.o + t * self.d
+
+
+def camera_rays(cam, x, y, nc: int, nr: int) -> Rays:
+    """The camera's rays through pixel coordinates (x, y) (n,) of an nc x nr image."""
+    ox, oy, oz, *d = primary_ray(cam.row, x, y, nc, nr)
+    return Rays(np.repeat(np.array([[ox], [oy], [oz]]), len(x), axis=1), np.array(d))

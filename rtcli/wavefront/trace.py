@@ -45,7 +45,7 @@ class Media:
 
 class Log:
     """A recorder: what trace() and shade.local() show it, for the rays at hand (arrays over them).
-    This base ignores everything; rtcli/explain.py keeps every term of one ray, rtcli/views.py
+    This base ignores everything; rtcli/inspect/explain.py keeps every term of one ray, rtcli/inspect/views.py
     how deep each pixel's rays go. `part` and `child` give the recorder of a subset of the rays:
     those that hit (`seen`), and those that spawn a reflected or refracted ray (`rows`)."""
 

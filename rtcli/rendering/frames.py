@@ -1,10 +1,9 @@
-"""Rendering an animation's frames, and any render on a cluster (README.md, Animation and Clusters).
+"""Rendering an animation's frames (README.md, Animation).
 
-`rtcli render` comes here for more than a plain still: a frame of an animated scene
-(`--frame N`), a sequence of frames to image files (`-o out/frame_%04d.png`, the
-frame number in printf's %d form) or to a movie (`-o movie.apng`, `--movie`), and
-whatever it renders on a Dask cluster (rtcli/cluster.py). Frames are rendered one
-after another, each on every core (or a frame a task on a cluster), and each file is
+`rtcli render` comes here for a sequence of frames to image files (`-o out/frame_%04d.png`,
+the frame number in printf's %d form) or to a movie (`-o movie.apng`, `--movie`).
+Frames are rendered one after another, each on every core (or a frame a task on a
+cluster, rtcli/cluster/renders.py), and each file is
 written, atomically, as soon as its frame is done: an interrupted run keeps the frames
 it finished, and `--skip-existing` renders only the frames whose files are missing.
 Every frame is checked (built) before the first is rendered, so an error in any of
@@ -13,57 +12,21 @@ them stops the run before it writes anything.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli import checks
 from rtcli.errors import RtcliError, shown
-from rtcli.movie import check_size, is_movie, movie_format, write_movie
-from rtcli.render import assemble, plan
-from rtcli.render import render as render_tiles  # `from rtcli import render` is the API function
-from rtcli.scenefile.animation import Animation, load_animation
+from rtcli.rendering.movie import check_size, is_movie, movie_format, write_movie
+from rtcli.rendering.tiles import render as render_tiles
+from rtcli.rendering.writer import write_png
+from rtcli.scenefile.animation import Animation
 from rtcli.stats import Stats
-from rtcli.writer import write_png
 
 PATTERN = re.compile(r"(?:[^%]|%%)*%0?[1-9]?\d*d(?:[^%]|%%)*", re.DOTALL)    # exactly one %d, %04d ...
-
-
-@dataclass
-class Loaded:
-    """A scene file read for a render: its animation, the scene of the frame asked for, the real
-    paths of its inputs, the files' bytes when they go to a cluster (cluster.Bundle), and the
-    warnings about frame 1 when they were asked for (lint.py)."""
-
-    animation: Animation
-    scene: object
-    frame: int
-    inputs: list
-    bundle: object = None
-    warnings: list = field(default_factory=list)
-
-
-def load(scene_file: str, frame: int | None = None, keep: bool = False, option: str = "--frame",
-         lint: bool = False) -> Loaded:
-    """The scene file with frame `frame` (default 1) built; `keep`: also the files' bytes;
-    `option` names the frame in messages; `lint`: also `rtcli validate`'s warnings (checks.py)."""
-    from rtcli.scene_api import check_frame
-    from rtcli.scenefile.files import collecting
-    from rtcli.scenefile.remarks import recording_remarks
-    with collecting() if keep else contextlib.nullcontext() as kept, \
-            recording_remarks() if lint else contextlib.nullcontext() as remarks:
-        animation, first, inputs = load_animation(scene_file)
-    k = frame or 1
-    check_frame(animation, k, scene_file, option)
-    found = checks.warnings(first, remarks) if lint else []
-    bundle = None
-    if keep:
-        from rtcli.cluster import Bundle
-        bundle = Bundle.of(scene_file, kept)
-    return Loaded(animation, first if k == 1 else animation.scene(k), k, inputs, bundle, found)
 
 
 def _frames_of(animation: Animation, scene_file: str) -> str:
@@ -81,53 +44,6 @@ def apply(scene, changes: dict):
     for name, value in changes.items():
         setattr(scene.settings, name, value)
     return scene
-
-
-# --- the cluster ---
-class Reach:
-    """The cluster of one command (a cluster.Target), connected when a render first needs it and
-    closed at the end of the `with` block: the scenes of a run share one connection (and one
-    --local-cluster), and a run with nothing to render reaches no cluster. `notes` hears what the
-    workers say about their engine (cluster.Session)."""
-
-    def __init__(self, target, notes=None):
-        self.target, self.notes, self._session, self._stack = target, notes, None, contextlib.ExitStack()
-
-    def session(self):
-        if self._session is None:
-            from rtcli.cluster import Session
-            self._session = self._stack.enter_context(Session(self.target, self.notes))
-        return self._session
-
-    def __enter__(self) -> Reach:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self._stack.close()
-
-
-@contextlib.contextmanager
-def _session(where):
-    """The session of `where`: a Reach's shared one, or one opened for the block (a cluster.Target)."""
-    if isinstance(where, Reach):
-        yield where.session()
-        return
-    from rtcli.cluster import Session
-    with Session(where) as session:
-        yield session
-
-
-# --- one image ---
-def render_image(loaded: Loaded, job, workers: int, progress=None, where=None, changes: dict | None = None):
-    """The image (or ids) of the loaded frame: on this machine's cores, or on the cluster `where`
-    (a cluster.Target, or a Reach)."""
-    if where is None:
-        return render_tiles(loaded.scene, job, workers, progress)
-    stats, (tiles, traced) = Stats(), plan(loaded.scene, job)
-    with _session(where) as session:
-        results = session.tiles(loaded.bundle, changes or {}, loaded.frame, job, traced, tiles,
-                                1 if job.signature else loaded.scene.settings.samples)
-        return assemble(job, len(tiles), results, stats, progress), stats
 
 
 # --- sequences ---
@@ -206,10 +122,11 @@ def has_image(path: str, width: int, height: int) -> bool:
         return False
 
 
-def render_sequence(loaded: Loaded, seq: Sequence, job, workers: int, changes: dict, skip_existing: bool,
-                    progress=None, where=None) -> Stats:
+def render_sequence(loaded, seq: Sequence, job, skip_existing: bool, frames: Callable) -> Stats:
     """Render the sequence's frames, writing each file as its frame is done and the movies at the
-    end; frames whose files exist are skipped with `skip_existing` (read back for a movie)."""
+    end; frames whose files exist are skipped with `skip_existing` (read back for a movie).
+    `frames(todo)` yields (frame, image, stats) for the frames to do: local_frames here, or a
+    cluster's (rtcli/cluster/renders.py). `loaded` is the scene file (api.loading.Loaded)."""
     todo = to_render(seq, skip_existing, job)
     if seq.movies:
         check_size(len(seq.frames), job.width, job.height)
@@ -218,7 +135,7 @@ def render_sequence(loaded: Loaded, seq: Sequence, job, workers: int, changes: d
             loaded.animation.scene(k)                          # every frame checked before any is rendered
     movie = {k: _read_back(seq.paths[k], job) for k in seq.frames if k not in todo and seq.movies}
     stats = Stats()
-    for k, image, s in _frames(loaded, todo, job, workers, changes, progress, where) if todo else ():
+    for k, image, s in frames(todo) if todo else ():
         if k in seq.paths:
             write_png(seq.paths[k], image)
         if seq.movies:
@@ -230,15 +147,8 @@ def render_sequence(loaded: Loaded, seq: Sequence, job, workers: int, changes: d
     return stats
 
 
-def _frames(loaded: Loaded, todo: list[int], job, workers: int, changes: dict, progress, where):
-    """(frame, image, stats) of each frame to do: here one after another, or on the cluster as they finish."""
-    if where is not None:
-        with _session(where) as session:
-            for done, result in enumerate(session.frames(loaded.bundle, changes, todo, job), 1):
-                if progress:
-                    progress(done, len(todo))
-                yield result
-        return
+def local_frames(loaded, todo: list[int], job, workers: int, changes: dict, progress=None):
+    """(frame, image, stats) of each frame to do, one after another on this machine's cores."""
     for i, k in enumerate(todo):
         scene = loaded.scene if k == loaded.frame else apply(loaded.animation.scene(k), changes)
         step = None if progress is None else (lambda done, total, i=i: progress(i * total + done, len(todo) * total))

@@ -1,4 +1,5 @@
-"""`rtcli compare ACTUAL_DIR EXPECTED_DIR [--report DIR] [--junit FILE]`, end to end.
+"""Two folders compared as a suite of golden tests, end to end:
+`rtcli compare ACTUAL_DIR EXPECTED_DIR [--report DIR] [--junit FILE]`.
 
 Outputs are checked before anything is compared (the report folder as report.py
 says; the JUnit file as any output: never an input, a folder or a device). Then
@@ -12,15 +13,15 @@ import os
 import time
 from collections.abc import Callable
 
+from rtcli.compare.folders import compare_folders, images_under, total_line
 from rtcli.errors import RtcliError, shown
-from rtcli.folders import compare_folders, images_under, total_line
 
 
 def compare_dirs(actual: str, expected: str, image_options: dict, id_options: dict, report: str | None,
                  junit: str | None, echo: Callable[[str], None]) -> bool:
     """Compare the folders, print the lines, write the outputs; whether every pair passed."""
-    from rtcli.junit import junit_xml, write_junit
-    from rtcli.report import Report
+    from rtcli.compare.junit import junit_xml, write_junit
+    from rtcli.compare.report import Report
     _check_outputs(actual, expected, report, junit)
     start = time.perf_counter()
     built = Report(report, image_options["tolerance"], (actual, expected)) if report else None
@@ -58,8 +59,8 @@ def are_folders(actual: str, expected: str) -> bool:
 
 
 def _check_outputs(actual: str, expected: str, report: str | None, junit: str | None) -> None:
-    from rtcli.outputs import check_file_output
-    from rtcli.report import check_report_dir
+    from rtcli.compare.report import check_report_dir
+    from rtcli.rendering.outputs import check_file_output
     inputs = list(images_under(actual).values()) + list(images_under(expected).values())
     if report:
         check_report_dir(report, [actual, expected])

@@ -15,8 +15,8 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from rtcli import checks
 from rtcli.errors import RtcliWarning, one_line, shown
+from rtcli.inspect import checks
 from rtcli.scenefile.remarks import Remark
 
 

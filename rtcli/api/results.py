@@ -101,7 +101,7 @@ class ImageArray(np.ndarray):
         """The 8-bit image: linear colors clamped to [0, 1], optionally sRGB-encoded, rounded; an id
         map as its signature picture (a fixed color per id, as `rtcli signature` draws it); a
         debug view as its picture."""
-        from rtcli.writer import signature_colors, to_8bit
+        from rtcli.core.display import signature_colors, to_8bit
         if self.picture is not None:
             return ImageArray(self.picture, inputs=self.inputs)
         if self.is_ids:
@@ -121,8 +121,8 @@ class ImageArray(np.ndarray):
         """Write the image as `rtcli render` (or an id map as `rtcli signature --ids`) would: the format
         follows the extension, the file is replaced atomically, and an input of the scene, a
         folder or a device is refused (RtcliError)."""
-        from rtcli.outputs import check_outputs
-        from rtcli.writer import write_png
+        from rtcli.rendering.outputs import check_outputs
+        from rtcli.rendering.writer import write_png
         path = str(path)
         check_outputs([(path, self.is_ids)], list(self.inputs))
         write_png(path, np.asarray(self if self.is_ids else self.to_8bit()))

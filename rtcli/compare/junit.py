@@ -16,9 +16,9 @@ import datetime
 import socket
 import xml.etree.ElementTree as ET
 
+from rtcli.compare.folders import Pair, total_line
 from rtcli.errors import one_line
-from rtcli.folders import Pair, total_line
-from rtcli.writer import write_atomic
+from rtcli.rendering.writer import write_atomic
 
 
 def junit_xml(pairs: list[Pair], properties: dict[str, str], seconds: float) -> bytes:

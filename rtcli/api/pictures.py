@@ -1,15 +1,6 @@
-"""rtcli as a library: load a scene, render it to a numpy array, a Pillow image or a file.
-
-    import rtcli
-    scene = rtcli.load_scene("scenes/whitted.yaml", width=320)   # a path, YAML text or a dict
-    image = rtcli.render(scene, samples=2)                       # uint8 (240, 320, 3); shows in Jupyter
-    image.save("whitted.png"); image.to_pil(); image.stats
-
-The command line is a thin layer over these functions and gives the same bytes
-(docs/python-api.md). Bad input raises RtcliError with the message the command
-line prints; a scene's errors are SceneErrors, located `file:line:col: key.path`
-(a dict's by `<dict>: key.path`).
-"""
+"""A loaded Scene rendered: its image (rtcli.render, Scene.render), its signature's ids
+(rtcli.signature) and the signature's legend. The command line is a thin layer over these and
+gives the same bytes (docs/python-api.md)."""
 
 from __future__ import annotations
 
@@ -21,43 +12,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rtcli.api.options import check_engine, check_options, image_size
+from rtcli.api.results import ImageArray, RenderStats
 from rtcli.errors import RtcliError, shown
-from rtcli.render import TILE
-from rtcli.results import ImageArray, RenderStats
-from rtcli.scene_api import Scene, Source, check_options, image_size, load
+from rtcli.rendering.outputs import check_outputs
+from rtcli.rendering.tiles import TILE, Job
+from rtcli.rendering.tiles import render as render_image
 
 Progress = Callable[[int, int], None]          # (tiles done, tiles in all)
 
 
-def load_scene(source: Source, *, width: int | None = None, height: int | None = None, samples: int | None = None,
-               max_depth: int | None = None, folder: str | os.PathLike | None = None,
-               frame: int | None = None) -> Scene:
-    """Read and check a scene: a path (str or os.PathLike), YAML text (a str with a line break, or
-    a flow mapping `{...}`) or a dict of the same keys (docs/scene-format.md).
-
-    width and height override the image size (one alone keeps the aspect ratio), samples and
-    max_depth the render settings, as the command line's options do. Relative file names in
-    YAML text or a dict are relative to `folder` (default: the current folder). `frame` picks
-    the frame of an animated scene (default 1; `scene.at(k)` gives another).
-    """
-    check_options(width=width, height=height, samples=samples, max_depth=max_depth, frame=frame)
-    scene = load(source, None if folder is None else os.fspath(folder), frame)
-    return scene.override(width=width, height=height, samples=samples, max_depth=max_depth)
-
-
-def _scene_of(scene: Scene | Source, frame: int | None) -> Scene:
-    """A Scene as given (at `frame` when one is given), or loaded from what load_scene takes."""
-    if isinstance(scene, Scene):
-        return scene if frame is None else scene.at(frame)
-    return load_scene(scene, frame=frame)
-
-
-def render(scene: Scene | Source, *, width: int | None = None, height: int | None = None, samples: int | None = None,
+def render_scene(scene, *, width: int | None = None, height: int | None = None, samples: int | None = None,
            max_depth: int | None = None, engine: str = "auto", workers: int | None = None,
            block_size: int = 1, tile: int = TILE, gamma: bool = False, bvh: bool = True,
            linear: bool = False, output: str | os.PathLike | None = None, progress: Progress | None = None,
-           notes: Callable[[str], None] | None = None, frame: int | None = None) -> ImageArray:
-    """Render a Scene (or what load_scene takes) to an ImageArray: uint8 (H, W, 3), or with
+           notes: Callable[[str], None] | None = None) -> ImageArray:
+    """Render a loaded Scene to an ImageArray: uint8 (H, W, 3), or with
     linear=True the float64 linear colors, unclamped.
 
     The options are the command line's: size (width or height alone keeps the aspect ratio),
@@ -67,11 +37,7 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
     as `rtcli render -o` (made before rendering). `progress(done, total)` is called per tile;
     `notes(text)` receives remarks: a stretched camera (default: warnings.warn), and that the
     compiled code is being compiled, once, and how long it took (default: printed on stderr).
-    `frame` renders that frame of an animated scene (default: the Scene's own, frame 1 when
-    loaded here).
     """
-    check_options(frame=frame)
-    scene = _scene_of(scene, frame)
     check_options(width=width, height=height, samples=samples, max_depth=max_depth, engine=engine,
                   workers=workers, block_size=block_size, tile=tile, gamma=gamma, bvh=bvh, linear=linear)
     if linear and gamma:
@@ -82,7 +48,6 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
         (notes or _warn)(note)
     if output is not None:
         _check_output(os.fspath(output), scene, False)
-    from rtcli.render import Job
     job = Job(w, h, block_size, tile=tile, gamma=gamma, engine=engine, bvh=bvh, linear=linear)
     with scene.model.settings.overridden(samples, max_depth) as s:
         pixels, counts, seconds = _run(scene, job, workers, progress, notes)
@@ -93,19 +58,15 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
     return image
 
 
-def signature(scene: Scene | Source, *, width: int | None = None, height: int | None = None, block_size: int = 1,
-              workers: int | None = None, output: str | os.PathLike | None = None,
-              frame: int | None = None) -> ImageArray:
+def signature_scene(scene, *, width: int | None = None, height: int | None = None, block_size: int = 1,
+              workers: int | None = None, output: str | os.PathLike | None = None) -> ImageArray:
     """The scene signature (notes 000 11.4) as an ImageArray of uint16 (H, W): per pixel the id of
     the first object hit, 0 for the background. It shows as the color-coded picture;
-    `output` writes the ids as `rtcli signature --ids` does (a 16-bit PNG). `frame` as for render."""
-    check_options(frame=frame)
-    scene = _scene_of(scene, frame)
+    `output` writes the ids as `rtcli signature --ids` does (a 16-bit PNG)."""
     check_options(width=width, height=height, block_size=block_size, workers=workers)
     check_ids(scene)
     if output is not None:
         _check_output(os.fspath(output), scene, True)
-    from rtcli.render import Job
     w, h, _ = image_size(scene.model, width, height)
     ids, counts, seconds = _run(scene, Job(w, h, block_size, signature=True), workers, None, None)
     image = ImageArray(ids, RenderStats.of(w, h, 1, counts, seconds), scene.inputs)
@@ -124,14 +85,14 @@ class LegendRow:
     pixels: int
 
 
-def legend(scene: Scene, ids: np.ndarray) -> list[LegendRow]:
+def legend(scene, ids: np.ndarray) -> list[LegendRow]:
     """The rows of `rtcli signature --legend`: the background (id 0), then every object."""
     counts = np.bincount(np.asarray(ids).ravel(), minlength=len(scene.model.objects) + 1)
     rows = [LegendRow(0, "(background)", "-", int(counts[0]))]
     return rows + [LegendRow(o.id, o.name, o.kind, int(counts[o.id])) for o in scene.model.objects]
 
 
-def check_ids(scene: Scene) -> None:
+def check_ids(scene) -> None:
     """RtcliError when the scene has more objects than 16-bit signature ids can tell apart."""
     if len(scene.model.objects) > 65535:
         raise RtcliError(f"{shown(scene.source)}: {len(scene.model.objects)} objects, but signature ids are "
@@ -142,23 +103,13 @@ def _warn(note: str) -> None:
     warnings.warn(note, stacklevel=3)                 # at the caller of render()
 
 
-def _run(scene: Scene, job, workers: int | None, progress, notes):
+def _run(scene, job, workers: int | None, progress, notes):
     """The pixels, the counts, and the seconds of the render without the compiled code's start-up
     (counts.load_seconds)."""
-    from rtcli.render import render as render_image
     start = time.perf_counter()
     pixels, counts = render_image(scene.model, job, workers or os.cpu_count() or 1, progress, notes)
     return pixels, counts, time.perf_counter() - start - counts.load_seconds
 
 
-def check_engine(engine: str) -> None:
-    """RtcliError when the compiled engine is asked for without numba."""
-    from rtcli import variants
-    if engine == "compiled" and not variants.ENABLED:
-        raise RtcliError("--engine compiled needs numba: pip install -e '.[fast]' in the rtcli folder "
-                         "(rtcli is not on the package index)")
-
-
-def _check_output(path: str, scene: Scene, ids: bool) -> None:
-    from rtcli.outputs import check_outputs
+def _check_output(path: str, scene, ids: bool) -> None:
     check_outputs([(path, ids)], list(scene.inputs))

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli import compare as gate
+from rtcli.compare import images as gate
 from rtcli.errors import RtcliError, one_line, plural, shown
 
 RANK = {"unreadable": 0, "missing": 1, "extra": 2, "failing": 3, "ok": 4}      # worst first

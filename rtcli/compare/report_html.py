@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from html import escape
 
-from rtcli.folders import Pair, total_line
+from rtcli.compare.folders import Pair, total_line
 
 STYLE = """
 body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em; color: #222; }

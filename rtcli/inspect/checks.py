@@ -151,8 +151,8 @@ def _wholly_in_view(scene: Scene, cam) -> bool:
 def _signature_hits(scene: Scene, size: int, objects=None) -> bool:
     """Whether a primary ray through a pixel centre of the image scaled to `size` pixels on its
     long side (never enlarged) hits an object (of `objects` when given, else any)."""
-    from rtcli.render import camera_rays
     from rtcli.wavefront.intersect import find_first_hit, nearest_over, no_hits
+    from rtcli.wavefront.rays import camera_rays
     s = scene.settings
     scale = min(1.0, size / max(s.width, s.height))
     w, h = max(1, round(s.width * scale)), max(1, round(s.height * scale))

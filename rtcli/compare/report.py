@@ -21,11 +21,12 @@ import tempfile
 import numpy as np
 from PIL import Image
 
-from rtcli import compare as gate
+from rtcli.compare import images as gate
+from rtcli.compare.folders import Pair, comparable
+from rtcli.compare.report_html import page
+from rtcli.core.display import signature_colors
 from rtcli.errors import RtcliError, shown
-from rtcli.folders import Pair, comparable
-from rtcli.report_html import page
-from rtcli.writer import current_umask, signature_colors
+from rtcli.rendering.writer import current_umask
 
 MARKER = ".rtcli-report"
 

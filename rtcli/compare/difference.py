@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli import compare as gate
+from rtcli.api.results import ImageArray, png_bytes
+from rtcli.compare import images as gate
 from rtcli.errors import RtcliError
-from rtcli.results import ImageArray, png_bytes
 
 GATE = {"tolerance": 2, "max_bad_pixels": 16, "max_bad_fraction": 1e-4, "max_cluster": 3}
 ID_GATE = {"max_boundary_mismatch": 8, "max_boundary_fraction": 0.01}
@@ -81,6 +81,6 @@ def pixels(image, name: str = "image") -> np.ndarray:
     if array.dtype.kind == "f":
         if array.ndim != 3 or array.shape[2] != 3:
             raise RtcliError(f"{name} is not an RGB image (H, W, 3): got {array.dtype} array of shape {array.shape}")
-        from rtcli.writer import to_8bit
+        from rtcli.core.display import to_8bit
         return to_8bit(array)
     return array

@@ -1,5 +1,6 @@
 """The ray tree of `rtcli explain` as text (docs/debugging.md): one ray a block, its terms under it,
-its secondary rays nested, and the sum at the foot of every block.
+its secondary rays nested, and the sum at the foot of every block. The tree's types (raytree.py)
+print themselves through these functions, which read their fields and import nothing of them.
 
 `style(text, role)` colors a piece by its role (ray, miss, term, sum, note); the command line
 passes click.style's colors, which it shows only on a terminal.
@@ -7,12 +8,7 @@ passes click.style's colors, which it shows only on a terminal.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
-
-if TYPE_CHECKING:                                   # explain.py imports this module to print itself
-    from rtcli.explain import Explanation, LightTerm, RayNode
 
 BRANCH, PIPE, INDENT = "├─ ", "│  ", "   "
 
@@ -25,7 +21,7 @@ def vec(v) -> str:
     return "(" + ", ".join(num(float(c)) for c in v) + ")"
 
 
-def format_explanation(e: Explanation, sample: int | None, style) -> str:
+def format_explanation(e, sample: int | None, style) -> str:
     """The pixel's line, then the tree of the sample asked for (every sample for None)."""
     per_pixel = e.samples ** 2
     lines = [style(f"pixel ({e.x}, {e.y}) of {e.width}x{e.height} = {vec(e.value)}", "sum")
@@ -44,7 +40,7 @@ def format_explanation(e: Explanation, sample: int | None, style) -> str:
     return "\n".join(lines)
 
 
-def node_lines(node: RayNode, style, cos_name: str = "R.V") -> list[str]:
+def node_lines(node, style, cos_name: str = "R.V") -> list[str]:
     head = f"{node.kind} ray, depth {node.depth}: from {vec(node.origin)} along {vec(node.direction)}"
     out = [style(head, "ray")]
     if node.hit is None:
@@ -83,7 +79,7 @@ def node_lines(node: RayNode, style, cos_name: str = "R.V") -> list[str]:
     return out
 
 
-def light_lines(light: LightTerm, style, cos_name: str) -> list[str]:
+def light_lines(light, style, cos_name: str) -> list[str]:
     out = [f"light {light.index} ({light.kind} at {vec(light.position)}, I {vec(light.color)})"]
     if len(light.samples) == 1:
         s = light.samples[0]

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.errors import RtcliError, SceneError, error_line, shown
-from rtcli.writer import FORMATS
+from rtcli.rendering.writer import FORMATS
 
 SCENE_SUFFIXES = (".yaml", ".yml")
 
@@ -79,8 +79,8 @@ def run(items: list[Item], folder: str | None, load: Callable, render: Callable,
     folder made for them stays, even empty. An error about the outputs (one that is an input of
     a scene, or cannot be written) still stops the run with nothing placed.
     """
-    from rtcli.outputs import check_outputs
-    from rtcli.writer import Staged
+    from rtcli.rendering.outputs import check_outputs
+    from rtcli.rendering.writer import Staged
     made = make_folder(folder)
     done, inputs, outputs = [], [], [(item.output, ids) for item in items]
     try:

@@ -18,7 +18,7 @@ import numpy as np
 from PIL import Image
 
 from rtcli.errors import RtcliError, quoted, shown
-from rtcli.writer import write_atomic
+from rtcli.rendering.writer import write_atomic
 
 FORMATS = {".apng": "PNG", ".gif": "GIF"}
 TICK = {"PNG": 1, "GIF": 10}              # ms: the step of a frame's delay as written (Pillow's APNG: 1/1000 s)

@@ -21,15 +21,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli import compiled, variants, wavefront
-from rtcli.core.camera import primary_ray
-from rtcli.core.jitter import hash_pixel
+from rtcli.core.display import to_8bit
+from rtcli.core.jitter import sample_positions
 from rtcli.core.scene import Scene
-from rtcli.pool import held_signals, stop_pool, watch_worker, worker_died
+from rtcli.rendering.pool import held_signals, stop_pool, watch_worker, worker_died
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
-from rtcli.wavefront.rays import Rays
+from rtcli.wavefront.rays import camera_rays
 from rtcli.wavefront.trace import trace
-from rtcli.writer import to_8bit
 
 TILE = 128                                 # tile edge in pixels (rays per tile: TILE^2 x samples^2)
 
@@ -47,27 +46,6 @@ class Job:
     engine: str = "auto"             # auto, numpy or compiled (see rtcli.compiled.choose)
     bvh: bool = True                 # a BVH over the scene's objects when there are enough (Scene.wants_bvh)
     linear: bool = False             # keep the traced colors (float64, unclamped) instead of 8 bits
-
-
-def sample_positions(i: np.ndarray, j: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """n x n stratified, jittered sample positions per pixel, shape (n*n, len(i)) each.
-
-    With n = 1 the single sample is the pixel centre (i + 0.5, j + 0.5).
-    """
-    if n == 1:
-        return (i + 0.5)[None, :], (j + 0.5)[None, :]
-    xs, ys = [], []
-    for cell in range(n * n):
-        a, b = divmod(cell, n)
-        xs.append(i + (b + hash_pixel(i, j, cell, 0)) / n)
-        ys.append(j + (a + hash_pixel(i, j, cell, 1)) / n)
-    return np.array(xs), np.array(ys)
-
-
-def camera_rays(cam, x, y, nc: int, nr: int) -> Rays:
-    """The camera's rays through pixel coordinates (x, y) (n,) of an nc x nr image."""
-    ox, oy, oz, *d = primary_ray(cam.row, x, y, nc, nr)
-    return Rays(np.repeat(np.array([[ox], [oy], [oz]]), len(x), axis=1), np.array(d))
 
 
 def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,

@@ -1,4 +1,5 @@
-"""Debug views as data: what the ray through each pixel's centre finds (rtcli.view, render --view).
+"""Debug views as data: what the ray through each pixel's centre finds (rtcli.view, render --view;
+the API's `view` in rtcli/api/__init__.py loads the scene and calls view_of).
 
 The rays are traced by the numpy engine's own functions (intersect.find_first_hit,
 intersect.surface, trace.trace), so a view shows exactly what the render sees. Views are
@@ -24,10 +25,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.errors import RtcliError, plural
-from rtcli.results import ImageArray
-from rtcli.scene_api import Scene, Source
-from rtcli.wavefront.trace import Log
+from rtcli.core.display import signature_colors, to_8bit
+from rtcli.errors import plural
+from rtcli.stats import Stats
+from rtcli.wavefront.intersect import find_first_hit, surface, uv_at_hits
+from rtcli.wavefront.rays import camera_rays
+from rtcli.wavefront.trace import Log, trace
 
 KINDS = ("normal", "depth", "uv", "albedo", "bounces", "ids")
 
@@ -53,29 +56,19 @@ class Deepest(Log):
         return Deepest(self.depth, self.index[rows])
 
 
-def view(scene: Scene | Source, kind: str, *, width: int | None = None, height: int | None = None,
-         tile: int = 128) -> ImageArray:
-    """The view `kind` (KINDS) of a Scene, or of what rtcli.load_scene takes, at its size or the one given."""
-    from rtcli import api, wavefront
-    from rtcli.scene_api import check_options, image_size
-    if kind not in KINDS:
-        raise RtcliError(f"the view must be one of {', '.join(KINDS)}, got {kind!r}")
-    scene = scene if isinstance(scene, Scene) else api.load_scene(scene)
-    if kind == "ids":
-        return api.signature(scene, width=width, height=height, workers=1)
-    check_options(width=width, height=height, tile=tile)
-    w, h, _ = image_size(scene.model, width, height)
-    model = scene.model
-    wavefront.prepare(model)
-    shape = {"depth": (h, w), "bounces": (h, w), "uv": (h, w, 2)}.get(kind, (h, w, 3))
+def view_of(model, kind: str, width: int, height: int, tile: int = 128) -> np.ndarray:
+    """The data of view `kind` (KINDS but ids, which is the signature) of a scene model readied for
+    the numpy engine, at width x height, computed tile by tile."""
+    shape = {"depth": (height, width), "bounces": (height, width), "uv": (height, width, 2)}.get(
+        kind, (height, width, 3))
     out = np.full(shape, _MISS[kind], dtype=np.int16 if kind == "bounces" else float)
-    cam = model.camera(w, h)
-    for top, left in ((top, left) for top in range(0, h, tile) for left in range(0, w, tile)):
-        rows, cols = np.arange(top, min(top + tile, h)), np.arange(left, min(left + tile, w))
+    cam = model.camera(width, height)
+    for top, left in ((top, left) for top in range(0, height, tile) for left in range(0, width, tile)):
+        rows, cols = np.arange(top, min(top + tile, height)), np.arange(left, min(left + tile, width))
         jj, ii = (a.ravel() for a in np.meshgrid(rows, cols, indexing="ij"))
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            out[jj, ii] = _tile(model, kind, cam, ii, jj, w, h)
-    return ImageArray(out, inputs=scene.inputs, picture=picture(out, kind, model.settings.max_depth))
+            out[jj, ii] = _tile(model, kind, cam, ii, jj, width, height)
+    return out
 
 
 _MISS = {"normal": 0.0, "depth": np.inf, "uv": np.nan, "albedo": 0.0, "bounces": -1}
@@ -83,10 +76,6 @@ _MISS = {"normal": 0.0, "depth": np.inf, "uv": np.nan, "albedo": 0.0, "bounces":
 
 def _tile(model, kind: str, cam, ii, jj, w: int, h: int) -> np.ndarray:
     """The view's values at pixels (ii, jj): (n,) or (n, channels)."""
-    from rtcli.render import camera_rays
-    from rtcli.stats import Stats
-    from rtcli.wavefront.intersect import find_first_hit, surface, uv_at_hits
-    from rtcli.wavefront.trace import trace
     rays = camera_rays(cam, ii + 0.5, jj + 0.5, w, h)
     if kind == "bounces":
         deepest = Deepest(np.zeros(len(rays), dtype=np.int64), np.arange(len(rays)))
@@ -108,7 +97,6 @@ def _tile(model, kind: str, cam, ii, jj, w: int, h: int) -> np.ndarray:
 
 def picture(data: np.ndarray, kind: str, max_depth: int = 5) -> np.ndarray:
     """How a view shows, 8-bit (H, W, 3) (see the module's docstring)."""
-    from rtcli.writer import signature_colors, to_8bit
     data = np.asarray(data)
     if kind == "ids":
         return signature_colors(data)
