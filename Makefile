@@ -13,15 +13,16 @@ $(BASE): pyproject.toml
 	$(PY) -m pip install --quiet -e .
 	touch $(BASE)
 
-# Everything the tests use: numba (the compiled engine), FLIP, Dask, the test tools.
+# Everything the tests use: numba (the compiled engine), FLIP, Dask, the preview's server, the test tools.
 $(FULL): $(BASE)
-	$(PY) -m pip install --quiet -e '.[test,fast,flip,cluster]'
+	$(PY) -m pip install --quiet -e '.[test,fast,flip,cluster,preview]'
 	touch $(FULL)
 
 # The first image at once, with the numpy engine: no numba to install or compile.
 demo: $(BASE)
 	$(VENV)/bin/rtcli render scenes/whitted.yaml -o whitted.png --stats
 	@echo "wrote whitted.png. Next: make warmup (numba's compiled engine, several times faster on big images; it compiles once)"
+	@echo "Live in the browser: $(PY) -m pip install -e '.[preview]', then $(VENV)/bin/rtcli preview scenes/whitted.yaml"
 
 # Compile the compiled engine once (numba caches it), so no render waits for it; it says how far it has got.
 warmup: $(FULL)

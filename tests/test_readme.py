@@ -50,6 +50,8 @@ ELSEWHERE = {
     "rtcli render scenes/whitted.yaml --watch": "runs until Ctrl-C: tests/test_watch.py",
     "rtcli render scene.yaml --watch": "runs until Ctrl-C, on a scene of the reader's: tests/test_watch.py",
     "rtcli warmup": "compiles the compiled engine (minutes with a cold cache): tests/test_startup.py",
+    "rtcli preview scenes/whitted.yaml": "serves a page until Ctrl-C: tests/test_preview.py, and in a browser "
+                                         "tests/test_preview_browser.py",
     "rtcli warmup --cluster tcp://127.0.0.1:8786":
         "needs a Dask scheduler at that address: tests/test_cluster.py warms clusters it starts",
 }

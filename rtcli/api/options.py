@@ -9,7 +9,7 @@ from rtcli.scenefile.build import camera_form, check_image_size
 
 RANGES = {"width": (1, 32768), "height": (1, 32768), "samples": (1, 16), "max_depth": (1, 64),
           "workers": (1, 256), "block_size": (1, 1024), "tile": (1, 4096),
-          "frame": (1, 100_000)}          # as the command line's (frame: scenefile.animation.MAX_FRAMES)
+          "frame": (1, 100_000)}          # as the command line's (frame: scenefile.clock.MAX_FRAMES)
 
 
 def check_options(**options) -> None:

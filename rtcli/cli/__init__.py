@@ -1,5 +1,5 @@
 """The rtcli command line (README.md, Commands): render, signature, explain, compare, validate,
-presets, warmup; one module a command, this one the group that wires them.
+preview, presets, warmup; one module a command, this one the group that wires them.
 
 Argument handling only: each command parses its options and calls the library. Errors from the
 library (RtcliError) and usage errors become one `error: ...` line on stderr with exit code 2;
@@ -20,6 +20,7 @@ import click
 from rtcli import __version__
 from rtcli.cli.compare import compare
 from rtcli.cli.explain import explain
+from rtcli.cli.preview import preview
 from rtcli.cli.render import render
 from rtcli.cli.signature import signature
 from rtcli.cli.validate import presets, validate
@@ -92,5 +93,5 @@ def main(debug):
     # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
-for _command in (render, signature, explain, compare, validate, presets, warmup):
+for _command in (render, signature, explain, compare, validate, preview, presets, warmup):
     main.add_command(_command)

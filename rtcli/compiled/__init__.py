@@ -26,6 +26,7 @@ it starts at once, and `auto` takes it for any size.
 
 from __future__ import annotations
 
+import copy
 import os
 import time
 from pathlib import Path
@@ -73,6 +74,14 @@ class Compiled:
             self.load += Load(spent, spent)
             (notes or say)(f"machine code file written in {spent:.1f} s: later renders start without numba" if
                            why is None else f"no machine code file ({why}): later renders load numba")
+
+    def twin(self) -> Compiled:
+        """The same engine with scratch of its own (the integrator's stack and frames), for another
+        thread; the packed scene is shared, and only read. The machine code file's entry lets go of
+        Python's lock while it traces (ctypes), so twins trace at once (rtcli/preview/passes.py)."""
+        other = copy.copy(self)
+        other.stack, other.frames = np.empty_like(self.stack), np.empty_like(self.frames)
+        return other
 
     def _args(self, cam_row, x, y, nc, nr, counts, out) -> tuple:
         return self.geometry, self.looks, cam_row, x, y, nc, nr, counts, self.stack, out, self.frames

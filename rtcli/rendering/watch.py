@@ -16,6 +16,7 @@ and the watch goes on; Ctrl-C ends it (cli.py).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections.abc import Callable
@@ -30,15 +31,26 @@ POLL = 0.25                        # seconds between looks at the files
 def watch(scene: str, render: Callable[[], None], error: Callable[[str], None], poll: float = POLL) -> None:
     """Call render() (which loads `scene`, renders and writes it) now and after every change of
     the files it read; a failure goes to error() as its one line. Runs until interrupted."""
-    path, kept = os.path.realpath(scene), Kept()
+    kept = Kept()
     while True:
-        with recording_stamps() as seen, reusing(kept):
+        with recording(scene, kept) as seen:
             try:
                 render()
             except (RtcliError, MemoryError) as e:
                 error(f"error: {one_line(str(e) or 'out of memory')}")
-        seen.setdefault(path, _now(path))                # the scene, even when it was never read
         _wait_for_change(seen, poll)
+
+
+@contextlib.contextmanager
+def recording(scene: str, kept: Kept):
+    """The stamps of the files a load within the block reads (the scene's own even when it was
+    never read), the meshes of the previous load in `kept` reused when their files did not change."""
+    path = os.path.realpath(scene)
+    with recording_stamps() as seen, reusing(kept):
+        try:
+            yield seen
+        finally:
+            seen.setdefault(path, _now(path))
 
 
 def _now(path: str):
@@ -48,15 +60,26 @@ def _now(path: str):
         return None
 
 
+class Changes:
+    """Whether the files whose stamps a load recorded (`seen`) changed: poll() looks once, and is
+    true when a stamp differs from `seen`'s and held still since the previous look, so a save
+    caught half-written is not taken. The watch polls it between sleeps; `rtcli preview` between
+    the tiles of a render, which the change then stops (rtcli/preview/)."""
+
+    def __init__(self, seen: dict):
+        self.seen, self.last = seen, seen
+
+    def poll(self) -> bool:
+        now = {path: _now(path) for path in self.seen}
+        settled = now != self.seen and now == self.last
+        self.last = now
+        return settled
+
+
 def _wait_for_change(seen: dict, poll: float) -> None:
     """Return when a file's stamp differs from `seen`'s and has then held still for one poll."""
-    now = seen
-    while now == seen:
-        time.sleep(poll)
-        now = {path: _now(path) for path in seen}
+    changes = Changes(seen)
     while True:
         time.sleep(poll)
-        settled = {path: _now(path) for path in seen}
-        if settled == now:
+        if changes.poll():
             return
-        now = settled
