@@ -23,7 +23,8 @@ import threading
 from collections.abc import Callable
 
 from rtcli.errors import RtcliError, shown
-from rtcli.preview.session import Options, Session
+from rtcli.preview.options import Options
+from rtcli.preview.session import Session
 
 __all__ = ["Options", "serve"]
 

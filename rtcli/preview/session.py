@@ -20,14 +20,14 @@ import queue
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
 from rtcli.errors import RtcliError, error_line, one_line, plural, shown
-from rtcli.preview import messages
-from rtcli.preview.passes import Progressive, passes
 from rtcli.inspect.views import KINDS as VIEWS
+from rtcli.preview import messages
+from rtcli.preview.options import Options
+from rtcli.preview.passes import Progressive, passes
 from rtcli.rendering.watch import Changes, recording
 
 POLL = 0.05                        # seconds between looks at the scene's files
@@ -37,21 +37,6 @@ PENDING = 16                       # questions waiting for the thread at most; m
 
 class Busy(RtcliError):
     """Too many questions wait already."""
-
-
-@dataclass(frozen=True)
-class Options:
-    """The render options of `rtcli preview` (as `rtcli render` takes them)."""
-
-    width: int | None = None
-    height: int | None = None
-    samples: int | None = None
-    max_depth: int | None = None
-    engine: str = "auto"
-    gamma: bool = False
-    bvh: bool = True
-    frame: int = 1
-    workers: int | None = None     # threads tracing tiles with the compiled engine (default: all cores)
 
 
 class Session:
