@@ -63,8 +63,8 @@ ROW, DEPTH, PATH = 1, 2, 4                         # columns of leaves (KIND and
 # 0 the mirror ray, 1 the refracted ray, 2 done), the weights of the mirror and refracted rays,
 # the refracted direction, and the media the ray is in: how many, then their iors (max_depth
 # slots from MEDIA_IOR on).
-COLOR_SUM, P, N, NG, D, ENTERING, MATERIAL_OF, STAGE = 0, 3, 6, 9, 12, 15, 16, 17
-W_REFLECT, W_REFRACT, REFRACTED_DIR, MEDIA_COUNT, MEDIA_IOR = 18, 21, 24, 27, 28
+(COLOR_SUM, P, N, NG, D, ENTERING, MATERIAL_OF, STAGE,
+ W_REFLECT, W_REFRACT, REFRACTED_DIR, MEDIA_COUNT, MEDIA_IOR) = 0, 3, 6, 9, 12, 15, 16, 17, 18, 21, 24, 27, 28
 
 # Few arrays on purpose: numba passes each array argument as several machine words.
 Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool program leaves")
