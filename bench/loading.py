@@ -47,6 +47,7 @@ def phases(repeat: int) -> None:
     import numpy as np
 
     from rtcli import variants
+    from rtcli.compiled import build as compiled_build
     from rtcli.core import bvh_build
     from rtcli.scenefile import load, yamlfile
     from rtcli.scenefile.obj import read_obj
@@ -64,8 +65,8 @@ def phases(repeat: int) -> None:
              ("torus100k: Mesh (no tree)", cpu(lambda: Mesh.from_values(obj), repeat)),
              ("torus100k: BVH, numpy build", cpu(lambda: bvh_build.numpy_build(lo, hi, 4, 12), repeat))]
     if variants.ENABLED:
-        bvh_build.compiled_build(lo[:8], hi[:8], 4, 12)                        # numba loads, or compiles once
-        rows.append(("torus100k: BVH, compiled build", cpu(lambda: bvh_build.compiled_build(lo, hi, 4, 12), repeat)))
+        compiled_build.build(lo[:8], hi[:8], 4, 12)                        # numba loads, or compiles once
+        rows.append(("torus100k: BVH, compiled build", cpu(lambda: compiled_build.build(lo, hi, 4, 12), repeat)))
     print(f"{'phase (CPU s, least of ' + str(repeat) + ')':<40} {'s':>7}")
     for name, seconds in rows:
         print(f"{name:<40} {seconds:7.3f}")

@@ -11,6 +11,7 @@ import pytest
 from bvh_reference import build as reference_build
 
 from rtcli import machinecode, variants
+from rtcli.compiled import build as compiled_build
 from rtcli.core import bvh_build
 from rtcli.core.bvh import BVH
 from rtcli.scenefile.obj import read_obj
@@ -74,13 +75,13 @@ def test_numpy_build_is_the_reference_tree(case, leaf_size, bins):
 @pytest.mark.parametrize("case", cases(), ids=lambda c: c[0])
 def test_compiled_build_is_the_reference_tree(case, leaf_size, bins):
     _, lo, hi = case
-    same_tree(bvh_build.compiled_build(lo, hi, leaf_size, bins), reference_build(lo, hi, leaf_size, bins))
+    same_tree(compiled_build.build(lo, hi, leaf_size, bins), reference_build(lo, hi, leaf_size, bins))
 
 
 @pytest.mark.parametrize("case", cases()[:14] + cases()[-3:], ids=lambda c: c[0])
 def test_python_variant_of_the_compiled_build_is_the_reference_tree(case):
     _, lo, hi = case
-    same_tree(bvh_build.compiled_build(lo, hi, 2, 12, variants.python(bvh_build.levels)),
+    same_tree(compiled_build.build(lo, hi, 2, 12, variants.python(bvh_build.levels)),
               reference_build(lo, hi, 2, 12))
 
 
@@ -93,30 +94,34 @@ def test_models_and_the_bench_torus_give_the_reference_tree(model):
     ref = reference_build(lo, hi, 4, 12)
     same_tree(bvh_build.numpy_build(lo, hi, 4, 12), ref)
     if variants.ENABLED:
-        same_tree(bvh_build.compiled_build(lo, hi, 4, 12), ref)
+        same_tree(compiled_build.build(lo, hi, 4, 12), ref)
 
 
 @needs_numba
 def test_torus100k_compiled_is_the_reference_tree():
     lo, hi = face_boxes(os.path.join(HERE, "..", "bench", "torus100k.obj"))
-    same_tree(bvh_build.compiled_build(lo, hi, 4, 12), reference_build(lo, hi, 4, 12))
+    same_tree(compiled_build.build(lo, hi, 4, 12), reference_build(lo, hi, 4, 12))
 
 
-def test_build_takes_the_compiled_build_once_numba_is_loaded_or_its_machine_code_is_at_hand(monkeypatch):
-    calls = []
+def test_the_compiled_build_is_at_hand_once_numba_is_loaded_or_its_machine_code_is(monkeypatch):
+    """compiled/build.py's runner, which the engine choice hands to what builds trees, exists when
+    the compiled `levels` starts at once; a tree given it builds through it."""
     monkeypatch.setattr(machinecode, "load", lambda name: None)
-    monkeypatch.setattr(bvh_build, "compiled_build", lambda *a: calls.append(len(a[0])) or bvh_build.numpy_build(*a))
     monkeypatch.setattr(variants, "ENABLED", True)
-    lo = np.random.default_rng(1).uniform(0, 1, (50, 3))
     monkeypatch.setitem(sys.modules, "numba", sys.modules.get("numba", object()))
-    BVH(lo, lo + 0.1)
-    assert calls == [50]
+    assert compiled_build.runner() is compiled_build.run
     monkeypatch.delitem(sys.modules, "numba")
-    BVH(lo, lo + 0.1)
+    assert compiled_build.runner() is None
+    monkeypatch.setattr(machinecode, "load", lambda name: name == compiled_build.LEVELS and object())
+    assert compiled_build.runner() is compiled_build.run
+    monkeypatch.setattr(variants, "ENABLED", False)
+    assert compiled_build.runner() is None
+    calls = []
+    run = variants.python(bvh_build.levels)
+    lo = np.random.default_rng(1).uniform(0, 1, (50, 3))
+    tree = BVH(lo, lo + 0.1, levels=lambda *args: calls.append(len(args[0])) or run(*args))
     assert calls == [50]
-    monkeypatch.setattr(machinecode, "load", lambda name: name == bvh_build.LEVELS and object())
-    BVH(lo, lo + 0.1)
-    assert calls == [50, 50]
+    np.testing.assert_array_equal(tree.perm, BVH(lo, lo + 0.1).perm)
 
 
 # --- a mesh builds its tree when first asked for ---

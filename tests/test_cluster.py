@@ -316,7 +316,7 @@ COMPILING = "compiling the render engine, once (about a minute); cached in /some
 def compiling(monkeypatch):
     """The engine's start-up on the `threads` workers (whose tasks give notes) replaced by one that says it compiles, waits
     until `heard` is set (at most 60 s; whether it was, in `waited`), and reports 2.5 s of compiling."""
-    rendering = sys.modules["rtcli.rendering.tiles"]
+    rendering = sys.modules["rtcli.rendering.engine"]
     real, heard, waited = rendering.prepare, threading.Event(), []
 
     def prepare(scene, job, traced, notes=None):
@@ -391,7 +391,7 @@ def test_a_note_ends_the_progress_bar_line_it_comes_under(capsys):
 
 
 def fake_warmup(compiles: set, fails: set):
-    """rtcli.compiled.warmup.warmup for the `threads` workers: a worker whose address is in `compiles`
+    """rtcli.rendering.warmup.warmup for the `threads` workers: a worker whose address is in `compiles`
     compiles the render engine for show (3.5 s, with its note); one in `fails` cannot load numba."""
     def warmup(notes=None):
         address = notes.worker.address
@@ -407,7 +407,7 @@ def fake_warmup(compiles: set, fails: set):
 
 
 def test_warmup_on_a_cluster_reports_each_worker(run, threads, monkeypatch):
-    from rtcli.compiled import warmup
+    from rtcli.rendering import warmup
     first, second = sorted(threads.scheduler_info["workers"])
     monkeypatch.setattr(warmup, "warmup", fake_warmup({second}, set()))
     result = run("warmup", "--cluster", threads.scheduler_address)
@@ -420,7 +420,7 @@ def test_warmup_on_a_cluster_reports_each_worker(run, threads, monkeypatch):
 
 
 def test_a_worker_that_cannot_be_warmed_is_one_line_and_exit_2(run, threads, monkeypatch):
-    from rtcli.compiled import warmup
+    from rtcli.rendering import warmup
     first, second = sorted(threads.scheduler_info["workers"])
     monkeypatch.setattr(warmup, "warmup", fake_warmup(set(), {first}))
     result = run("warmup", "--cluster", threads.scheduler_address)
@@ -457,7 +457,7 @@ def test_a_cold_worker_process_compiles_and_says_so(run, tmp_path):
     real, and the client hears it."""
     from test_startup import WALKS, seeded
 
-    from rtcli.compiled.warmup import warmup
+    from rtcli.rendering.warmup import warmup
     if variants.cache_location().root is not None:
         pytest.skip("the cache is not beside the sources here (RTCLI_CACHE_DIR or NUMBA_CACHE_DIR is set)")
     warmup(notes=lambda text: None)                     # the cache to seed from, warm

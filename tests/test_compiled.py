@@ -17,6 +17,7 @@ from helpers import without_avx512
 from rtcli import compiled as fast
 from rtcli import variants
 from rtcli.errors import RtcliError
+from rtcli.rendering.engine import AUTO_RAYS, choose
 from rtcli.rendering.tiles import Job, render, render_tile
 from rtcli.scenefile.load import load_scene
 
@@ -100,7 +101,7 @@ def test_colors_are_equal_to_the_last_bit(yaml_scene):
     i, j = np.meshgrid(np.arange(0, 640, 7), np.arange(0, 480, 5))
     job = Job(640, 480)
     a, _ = render_tile(scene, job, i.ravel(), j.ravel())
-    b, _ = render_tile(scene, job, i.ravel(), j.ravel(), fast.choose(scene, "compiled"))
+    b, _ = render_tile(scene, job, i.ravel(), j.ravel(), choose(scene, "compiled"))
     assert np.array_equal(a, b)
 
 
@@ -230,15 +231,15 @@ def test_unsupported_names_what_the_compiled_engine_lacks():
 def test_choose_falls_back_to_numpy_or_says_why(monkeypatch):
     csg = load_scene(str(ROOT / "scenes" / "csg.yaml"))
     whitted = load_scene(str(ROOT / "scenes" / "whitted.yaml"))
-    assert isinstance(fast.choose(csg, "auto"), fast.Compiled)
-    assert isinstance(fast.choose(csg, "compiled"), fast.Compiled)
-    assert fast.choose(whitted, "numpy") is None
-    assert fast.choose(whitted, "auto", rays=fast.AUTO_RAYS - 1) is None     # small jobs: no numba start-up
-    assert isinstance(fast.choose(whitted, "auto"), fast.Compiled)
+    assert isinstance(choose(csg, "auto"), fast.Compiled)
+    assert isinstance(choose(csg, "compiled"), fast.Compiled)
+    assert choose(whitted, "numpy") is None
+    assert choose(whitted, "auto", rays=AUTO_RAYS - 1) is None     # small jobs: no numba start-up
+    assert isinstance(choose(whitted, "auto"), fast.Compiled)
     monkeypatch.setattr(variants, "ENABLED", False)
-    assert fast.choose(whitted, "auto") is None
+    assert choose(whitted, "auto") is None
     with pytest.raises(RtcliError, match="numba is not installed"):
-        fast.choose(whitted, "compiled")
+        choose(whitted, "compiled")
 
 
 def test_a_source_change_drops_the_cached_machine_code(tmp_path, monkeypatch):
@@ -346,8 +347,8 @@ def test_corner_normals_that_cancel_fall_back_to_the_face(yaml_scene):
 def test_loading_the_engine_skips_numbas_blas_lookup_and_leaves_no_trace():
     import subprocess
     import sys
-    code = ("import sys; from rtcli.scenefile.load import load_scene; from rtcli import compiled as fast; "
-            "fast.choose(load_scene('scenes/whitted.yaml'), 'compiled'); "
+    code = ("import sys; from rtcli.scenefile.load import load_scene; from rtcli.rendering.engine import choose; "
+            "choose(load_scene('scenes/whitted.yaml'), 'compiled'); "
             "print('scipy.linalg' in sys.modules, 'scipy.linalg.cython_blas' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
@@ -584,10 +585,10 @@ def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_an
     """Below AUTO_RAYS, `auto` stays on numpy for plain scenes, but a mesh (or a set of spheres)
     makes the numpy engine load compiled walks itself, so the compiled engine is taken (once
     it is cached)."""
-    from rtcli.rendering.tiles import prepare
+    from rtcli.rendering.engine import prepare
     monkeypatch.setattr(fast, "ready_to_load", lambda: True)
     monkeypatch.setattr(fast, "starts_at_once", lambda: False)          # no machine code file
-    small = fast.AUTO_RAYS // 2
+    small = AUTO_RAYS // 2
     for name, expected in (("scenes/whitted.yaml", None), ("bench/torus100k.yaml", fast.Compiled),
                            ("bench/spheres1k.yaml", fast.Compiled)):
         scene = load_scene(str(ROOT / name))
@@ -599,11 +600,11 @@ def test_auto_takes_the_compiled_engine_for_a_small_job_that_would_load_numba_an
 def test_auto_stays_on_numpy_for_a_small_job_before_the_first_compile(monkeypatch, tmp_path):
     """Uncached, the integrator would compile for a minute where the numpy engine's walks take
     seconds: a small mesh job stays on numpy. ready_to_load reads the cache it is given."""
-    from rtcli.rendering.tiles import prepare
+    from rtcli.rendering.engine import prepare
     monkeypatch.setattr(fast, "ready_to_load", lambda: False)
     monkeypatch.setattr(fast, "starts_at_once", lambda: False)
     scene = load_scene(str(ROOT / "bench/torus100k.yaml"))
-    assert prepare(scene, Job(64, 48, engine="auto"), fast.AUTO_RAYS // 2)[0] is None
+    assert prepare(scene, Job(64, 48, engine="auto"), AUTO_RAYS // 2)[0] is None
     env = {**os.environ, "RTCLI_CACHE_DIR": str(tmp_path)}
     ask = "from rtcli import compiled; print(compiled.ready_to_load())"
     done = subprocess.run([sys.executable, "-c", ask], env=env, capture_output=True, text=True, cwd=ROOT)

@@ -20,6 +20,7 @@ import rtcli
 from rtcli import compiled
 from rtcli.cli import main
 from rtcli.inspect.explain import Recorder
+from rtcli.rendering.engine import choose
 from rtcli.rendering.tiles import Job, render_tile
 
 SCENES = sorted(str(p) for p in (Path(__file__).parent.parent / "scenes").glob("*.yaml"))
@@ -38,7 +39,7 @@ def explained(path: str, samples: int | None = None):
     explanations = [rtcli.explain(scene, int(x), int(y)) for x, y in zip(xs, ys)]
     job = Job(w, h)
     numpy_pixels = render_tile(model, job, xs, ys)[0]
-    engine = compiled.choose(model, "compiled" if compiled.unsupported(model) is None else "numpy", bvh=True)
+    engine = choose(model, "compiled" if compiled.unsupported(model) is None else "numpy", bvh=True)
     compiled_pixels = render_tile(model, job, xs, ys, engine)[0] if engine else None
     return explanations, numpy_pixels, compiled_pixels
 

@@ -18,7 +18,8 @@ from PIL import Image
 
 from rtcli import compiled as fast
 from rtcli import machinecode, variants
-from rtcli.core import bvh_build
+from rtcli.compiled import build as compiled_build
+from rtcli.rendering.engine import choose
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 
@@ -49,10 +50,10 @@ def files():
     """The engine's machine code files, beside numba's cache (made if missing)."""
     if machinecode.folder() is None:
         pytest.skip("no cache folder")
-    from rtcli.compiled.warmup import _scenes, machine_code
+    from rtcli.rendering.warmup import _scenes, machine_code
     machinecode._loaded.clear()
-    made, why = machine_code(fast.choose(_scenes()[0], "compiled", notes=lambda text: None))
-    assert made == [fast.ENTRY, bvh_build.LEVELS], why
+    made, why = machine_code(choose(_scenes()[0], "compiled", notes=lambda text: None))
+    assert made == [fast.ENTRY, compiled_build.LEVELS], why
     return machinecode.folder()
 
 

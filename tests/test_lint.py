@@ -177,7 +177,7 @@ def test_the_camera_check_proves_sight_without_tracing_when_it_can(monkeypatch):
     """An object wholly in view, or a floor seen, needs neither the BVH nor the scene's full trace."""
     traced = []
     monkeypatch.setattr("rtcli.wavefront.intersect.find_first_hit", lambda *a, **k: traced.append(1))
-    monkeypatch.setattr("rtcli.wavefront.prepare", lambda *a, **k: traced.append(1))
+    monkeypatch.setattr("rtcli.rendering.engine.numpy_engine", lambda *a, **k: traced.append(1))
     ball = model(CLEAN)
     floor = model(CLEAN.replace("{sphere: {}", "{plane: {point: [0, -1, 0]}}, {sphere: {center: [0, 0, 9]}")
                  .replace("look_at: [0, 0, 0]", "look_at: [0, -1, -1]"))

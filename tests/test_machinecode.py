@@ -17,7 +17,9 @@ import pytest
 
 from rtcli import compiled as fast
 from rtcli import machinecode, variants
+from rtcli.compiled import build as compiled_build
 from rtcli.core import bvh_build
+from rtcli.rendering.engine import choose
 from rtcli.rendering.tiles import Job, render_tile
 from rtcli.scenefile.load import load_scene
 
@@ -532,12 +534,12 @@ def test_helper_calls_are_found_on_the_paths_that_raise_nothing(change, found):
 def test_the_engines_modules_call_numbas_helpers_only_where_they_raise(engine_files):
     """The integrator's and the BVH build's modules (made by numba now, as make does) reach numba's
     helpers and Python's only on paths that raise, and do reference them there."""
-    from rtcli.compiled.warmup import _scenes
-    engine = fast.choose(_scenes()[0], "compiled", notes=lambda text: None)
+    from rtcli.rendering.warmup import _scenes
+    engine = choose(_scenes()[0], "compiled", notes=lambda text: None)
     lo = np.random.default_rng(0).random((64, 3))
     levels = variants.compiled(bvh_build.levels)
-    for name, body, args, results in [(fast.ENTRY, fast._trace_camera(), engine.empty_call, 0),
-                                      (bvh_build.LEVELS, levels, bvh_build.levels_args(lo, lo + 0.1, 2, 12), 2)]:
+    for name, body, args, results in [(fast.ENTRY, fast.compiled_integrator(), engine.empty_call, 0),
+                                      (compiled_build.LEVELS, levels, bvh_build.levels_args(lo, lo + 0.1, 2, 12), 2)]:
         _, module = machinecode._module(name, body, args, results)
         text = str(module)
         assert machinecode.helper_calls(text, machinecode.BODY_SYMBOL) == [], name
@@ -565,10 +567,10 @@ def engine_files():
     """The integrator's and the BVH build's files, beside numba's cache (made if missing)."""
     if machinecode.folder() is None:
         pytest.skip("no cache folder")
-    from rtcli.compiled.warmup import _scenes, machine_code
+    from rtcli.rendering.warmup import _scenes, machine_code
     machinecode._loaded.clear()
-    made, why = machine_code(fast.choose(_scenes()[0], "compiled", notes=lambda text: None))
-    assert made == [fast.ENTRY, bvh_build.LEVELS], why
+    made, why = machine_code(choose(_scenes()[0], "compiled", notes=lambda text: None))
+    assert made == [fast.ENTRY, compiled_build.LEVELS], why
     return made
 
 
@@ -578,7 +580,7 @@ SCENES = ["whitted", "csg", "bubble", "textures", "teapot", "inspect"]
 @pytest.mark.parametrize("name", SCENES)
 def test_the_integrators_file_gives_numbas_pixels(engine_files, name):
     scene = load_scene(str(ROOT / "scenes" / f"{name}.yaml"))
-    engine = fast.choose(scene, "compiled")
+    engine = choose(scene, "compiled")
     assert engine.entry is not None                      # from the file
     job = Job(64, 48, engine="compiled")
     i, j = np.meshgrid(np.arange(64), np.arange(48))
@@ -593,9 +595,9 @@ def test_the_bvh_builds_file_builds_the_reference_tree(engine_files):
     from bvh_reference import build as reference_build
     lo = np.random.default_rng(5).normal(size=(3000, 3))
     hi = lo + np.random.default_rng(6).uniform(0, 0.2, size=(3000, 3))
-    entry = machinecode.load(bvh_build.LEVELS)
+    entry = machinecode.load(compiled_build.LEVELS)
     assert entry is not None and entry.fits(bvh_build.levels_args(lo, hi, 2, 12))
-    tree = bvh_build.compiled_build(lo, hi, 2, 12, variant=entry)
+    tree = compiled_build.build(lo, hi, 2, 12, variant=entry)
     for got, want in zip(tree, reference_build(lo, hi, 2, 12)):
         assert np.array_equal(got, want)
 

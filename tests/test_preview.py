@@ -22,8 +22,8 @@ from preview_helpers import GREEN, LOOK, Page, Preview, read_page, save, write_s
 
 import rtcli
 from rtcli import variants
-from rtcli.inspect import views
 from rtcli.cli import main
+from rtcli.inspect import views
 from rtcli.preview import server
 from rtcli.preview.against import flip_installed
 from rtcli.preview.passes import Progressive, passes
@@ -74,8 +74,8 @@ def test_a_small_image_has_no_pass_of_blocks_as_big_as_itself():
 def test_changes_are_taken_once_they_hold_still(tmp_path):
     path = tmp_path / "a.yaml"
     path.write_text("one")
-    from rtcli.scenefile.reuse import Kept
     from rtcli.rendering.watch import recording
+    from rtcli.scenefile.reuse import Kept
     with recording(str(path), Kept()) as seen:
         pass
     changes = Changes(seen)

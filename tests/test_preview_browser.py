@@ -19,8 +19,8 @@ from PIL import Image
 from preview_helpers import DEADLINE, GREEN, LOOK, Preview, save, write_scene
 
 import rtcli
-from rtcli.inspect import views
 from rtcli.cli import main
+from rtcli.inspect import views
 from rtcli.preview.against import flip_installed
 
 CHROMIUM = "/usr/bin/chromium"

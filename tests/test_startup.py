@@ -23,6 +23,7 @@ import pytest
 from rtcli import compiled as fast
 from rtcli import machinecode, variants
 from rtcli.compiled import loading
+from rtcli.rendering.engine import choose
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
 
@@ -36,7 +37,7 @@ def warm():
     """The cache beside the sources, warm (a minute the first time if it is not)."""
     if variants.cache_location().root is not None:
         pytest.skip("the cache is not beside the sources here (RTCLI_CACHE_DIR or NUMBA_CACHE_DIR is set)")
-    from rtcli.compiled.warmup import warmup
+    from rtcli.rendering.warmup import warmup
     warmup(notes=lambda text: None)
 
 
@@ -271,7 +272,7 @@ def test_after_warmup_no_scene_compiles_anything(warm, monkeypatch):
     scenes = [load_scene(str(p)) for p in sorted((ROOT / "scenes").glob("*.yaml")) +
               sorted((ROOT / "bench").glob("*.yaml"))]
     for scene in scenes:
-        assert fast.choose(scene, "compiled").entry is not None
+        assert choose(scene, "compiled").entry is not None
     monkeypatch.setattr(machinecode, "ENABLED", False)
     monkeypatch.setattr(machinecode, "_loaded", {})
     for scene in scenes:

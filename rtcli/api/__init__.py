@@ -19,7 +19,6 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 
-from rtcli import wavefront
 from rtcli.api.loading import load
 from rtcli.api.options import check_options, image_size
 from rtcli.api.pictures import Progress, render_scene, signature_scene
@@ -28,6 +27,7 @@ from rtcli.api.scene import Scene, Source
 from rtcli.errors import RtcliError
 from rtcli.inspect.explain import Explanation, check_pixel, explain_pixel
 from rtcli.inspect.views import KINDS, picture, view_of
+from rtcli.rendering.engine import numpy_engine
 from rtcli.rendering.tiles import TILE
 
 
@@ -101,7 +101,7 @@ def view(scene: Scene | Source, kind: str, *, width: int | None = None, height: 
         return signature_scene(scene, width=width, height=height, workers=1)
     check_options(width=width, height=height, tile=tile)
     w, h, _ = image_size(scene.model, width, height)
-    wavefront.prepare(scene.model)
+    numpy_engine(scene.model)
     data = view_of(scene.model, kind, w, h, tile)
     return ImageArray(data, inputs=scene.inputs, picture=picture(data, kind, scene.model.settings.max_depth))
 
@@ -117,5 +117,5 @@ def explain(scene: Scene | Source, x: int, y: int, *, width: int | None = None, 
     w, h, _ = image_size(scene.model, width, height)
     check_pixel(x, y, w, h)
     with scene.model.settings.overridden(samples, max_depth):
-        wavefront.prepare(scene.model, bvh)
+        numpy_engine(scene.model, bvh)
         return explain_pixel(scene.model, x, y, w, h, gamma)

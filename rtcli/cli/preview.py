@@ -35,7 +35,7 @@ def preview(scene_file, port, host, no_browser, width, height, samples, max_dept
     """Serve a live preview of SCENE.yaml in the browser: it renders coarse to fine, renders again at
     every save of the scene or a file it reads, and explains the pixel clicked. Ctrl-C ends it
     (docs/preview.md). Needs the extra `preview`: pip install -e '.[preview]' in the rtcli folder."""
-    from rtcli.api.options import check_engine                             # start-up
+    from rtcli.api.options import check_engine  # start-up
     from rtcli.cli.terminal import stamped
     from rtcli.preview import Options, serve
     check_engine(engine)

@@ -23,8 +23,8 @@ def warmup(cluster, cluster_file, local_cluster):
         with where:
             return warm(where.session(), click.echo)
     from rtcli import machinecode, variants  # start-up
-    from rtcli.compiled.warmup import bytecode
-    from rtcli.compiled.warmup import warmup as warm
+    from rtcli.rendering.warmup import bytecode
+    from rtcli.rendering.warmup import warmup as warm
     start = time.perf_counter()
     machinecode.report_to(lambda text: click.echo(f"note: {text}", err=True))
     where = variants.cache_location() if variants.ENABLED else None

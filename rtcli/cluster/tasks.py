@@ -11,6 +11,7 @@ from collections import OrderedDict
 from rtcli.cluster.notes import told
 from rtcli.cluster.software import fingerprint, mismatch
 from rtcli.errors import RtcliError
+from rtcli.rendering import engine as engines
 from rtcli.rendering import tiles as rendering
 from rtcli.rendering.frames import apply
 from rtcli.scenefile import yamlfile
@@ -86,7 +87,7 @@ def tiles_task(spec: dict, blobs: dict, frame: int, job, traced: int, tiles: lis
 def _prepared(spec, blobs, frame, job, traced):
     """(scene, engine) of `frame`; the engine's notes, and its compile time, told to the client."""
     scene, notes = _scene(spec, blobs, frame), told()
-    engine, load = rendering.prepare(scene, job, traced, notes)
+    engine, load = engines.prepare(scene, job, traced, notes)
     if notes and load:
         notes.compiled(load.compile_seconds)
     return scene, engine

@@ -11,8 +11,8 @@ import time
 from rtcli.cluster.notes import Told
 from rtcli.cluster.software import fingerprint, mismatch
 from rtcli.cluster.target import connect_timeout
-from rtcli.compiled import warmup as warming
 from rtcli.errors import RtcliError
+from rtcli.rendering import warmup as warming
 
 
 async def warm_here(client: dict, dask_worker=None) -> dict:
@@ -27,7 +27,7 @@ def _warm(client: dict, notes: Told) -> dict:
 
 
 def _warmed(client: dict, notes: Told) -> dict:
-    """rtcli.compiled.warmup here, for a client whose software is this worker's, its notes told to
+    """rtcli.rendering.warmup here, for a client whose software is this worker's, its notes told to
     the client: {"parts": [(what, compile seconds)], "seconds": in all, "why": why a machine code
     file is missing}, or {"failed": why}."""
     start = time.perf_counter()

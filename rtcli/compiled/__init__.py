@@ -4,9 +4,11 @@ numpy's throughput on arrays bounds the wavefront engine (rtcli/wavefront/) at
 about 1.4 ns per element-operation, with dozens of operations per ray and bounce.
 This package runs the same integrator one ray at a time, compiled, on the same
 kernels (rtcli/variants.py), and gives the same pixels (tests/test_compiled.py
-renders every supported scene both ways). `--engine auto` (the default) takes it
-when numba is installed and the scene holds only what it supports
-(pack.unsupported), else the numpy engine.
+renders every supported scene both ways). Which engine renders a job is decided in one
+place, rtcli/rendering/engine.py, from what this package says: what it cannot render
+(pack.unsupported), why it cannot start (why_not), whether it starts at once or its code is
+cached (starts_at_once, ready_to_load). It also gives the numpy engine its compiled BVH
+walks (walks.py) and tree build (build.py), through that place.
 
 The integrator starts from its machine code file (rtcli/machinecode.py) when there is
 one for this process, at once and without numba. Otherwise numba is imported,
@@ -17,11 +19,7 @@ function it calls (in another file) does, so `drop_stale_cache` empties it, and 
 machine code files, whenever any source the engine is made of changes.
 
 Loading numba and its cached code takes about 0.5 s, more than the numpy engine needs
-for a small image, so without a machine code file `auto` takes the compiled engine only
-from AUTO_RAYS primary rays up (a 1280x800 image, or 640x480 with --samples 2), and for
-any size when the numpy engine would load compiled BVH walks itself (meshes, sets of
-spheres) and the integrator's code is already cached (rtcli/rendering/tiles.py). With the file,
-it starts at once, and `auto` takes it for any size.
+for a small image; with the machine code file it starts at once.
 """
 
 from __future__ import annotations
@@ -40,7 +38,7 @@ from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
 from rtcli.stats import Stats
 
-__all__ = ["AUTO_RAYS", "Compiled", "Load", "choose", "unsupported"]
+__all__ = ["Compiled", "Load", "ready_to_load", "starts_at_once", "unsupported", "why_not"]
 
 
 class Compiled:
@@ -65,11 +63,11 @@ class Compiled:
         self.entry, why = None, _import_integrator()
         if why:
             raise RtcliError(why)
-        self.load = ready([_trace_camera()], lambda: _trace_camera()(*args), "the render engine", "about a minute",
+        self.load = ready([compiled_integrator()], lambda: compiled_integrator()(*args), "the render engine", "about a minute",
                           notes, start)     # no ray: just the machine code
         if self.load.compile_seconds:                   # so that later processes start without numba
             began = time.perf_counter()
-            why = machinecode.make(ENTRY, _trace_camera(), args)
+            why = machinecode.make(ENTRY, compiled_integrator(), args)
             spent = time.perf_counter() - began
             self.load += Load(spent, spent)
             (notes or say)(f"machine code file written in {spent:.1f} s: later renders start without numba" if
@@ -91,7 +89,7 @@ class Compiled:
         counts = np.zeros(4, dtype=np.int64)
         x, y = (np.ascontiguousarray(v, dtype=float) for v in (x, y))
         colors = np.empty((len(x), 3))
-        (self.entry or _trace_camera())(*self._args(cam.row, x, y, nc, nr, counts, colors))
+        (self.entry or compiled_integrator())(*self._args(cam.row, x, y, nc, nr, counts, colors))
         stats.add(Stats(*(int(c) for c in counts)))
         return colors
 
@@ -99,7 +97,7 @@ class Compiled:
 ENTRY = "trace_camera"
 
 
-def _trace_camera():
+def compiled_integrator():
     from rtcli.compiled.integrator import trace_camera
     return variants.compiled(trace_camera)
 
@@ -155,7 +153,7 @@ def drop_stale_cache() -> None:
 _cache_checked = False
 
 
-def _load() -> str | None:
+def why_not() -> str | None:
     """Make the compiled integrator ready to load: its machine code file (rtcli/machinecode.py)
     when there is one for this process, else numba and the integrator imported; why not, if it
     cannot be. The cache is checked against the sources once a process (a batch, a watch or a
@@ -180,41 +178,18 @@ def _import_integrator() -> str | None:
     return None
 
 
-AUTO_RAYS = 1_000_000
-
-
 def ready_to_load() -> bool:
     """Whether the compiled integrator's machine code is at hand (its file, numba's cache, or in
     memory), so that starting the engine loads it rather than compiling for a minute: a forecast
     (loading.cached)."""
     if starts_at_once():
         return True
-    if _load() is not None:
+    if why_not() is not None:
         return False
-    entry = _trace_camera()
+    entry = compiled_integrator()
     return bool(entry.signatures) or cached(entry) is True
 
 
 def starts_at_once() -> bool:
     """Whether the compiled integrator would start from its machine code file, without numba."""
-    return _load() is None and machinecode.load(ENTRY) is not None
-
-
-def choose(scene, engine: str, rays: int = AUTO_RAYS, bvh: bool = True, notes=None) -> Compiled | None:
-    """The compiled engine for `scene`, or None for the numpy engine; RtcliError when
-    `engine` is "compiled" and it cannot be had. `rays`: how many primary rays the job traces;
-    `bvh`: a BVH over the scene's objects when there are enough of them; `notes`: where to say
-    that the engine is being compiled (loading.ready). Its `load` says how long it took to start."""
-    if engine == "numpy" or (engine == "auto" and rays < AUTO_RAYS):
-        return None
-    start = time.perf_counter()
-    shape = unsupported(scene)
-    why = f"it does not handle {shape} (--engine numpy does)" if shape else _load()
-    if why is None:
-        try:
-            return Compiled(scene, bvh, notes, start)
-        except RtcliError as e:                 # numba was needed after all, and cannot be loaded
-            why = str(e)
-    if engine == "compiled":
-        raise RtcliError(f"--engine compiled cannot render this scene: {why}")
-    return None
+    return why_not() is None and machinecode.load(ENTRY) is not None

@@ -45,7 +45,7 @@ NEAREST, ANY_CASTER, NEAREST_CASTER = 0, 1, 2     # what a per-ray walk looks fo
 class BVH:
     """BVH over m primitive boxes lo, hi (m, 3); see the module docstring."""
 
-    def __init__(self, lo: np.ndarray, hi: np.ndarray, leaf_size: int = 4, bins: int = 12):
+    def __init__(self, lo: np.ndarray, hi: np.ndarray, leaf_size: int = 4, bins: int = 12, levels=None):
         lo, hi = (np.asarray(x, dtype=float).reshape(-1, 3) for x in (lo, hi))
         self.m = len(lo)
         if self.m == 0:                 # an empty tree: one leaf holding nothing
@@ -54,7 +54,7 @@ class BVH:
             self.perm = np.zeros(0, dtype=np.int64)
             return
         self.box = (lo.min(axis=0), hi.max(axis=0))
-        n_lo, n_hi, child, start, count, self.perm, self.depth = build(lo, hi, leaf_size, bins)
+        n_lo, n_hi, child, start, count, self.perm, self.depth = build(lo, hi, leaf_size, bins, levels)
         n_lo, n_hi = padded(n_lo, n_hi, self.box)
         self.nodes = np.ascontiguousarray(np.concatenate([n_lo, n_hi], axis=1))
         self.links = np.ascontiguousarray(np.stack([child, start, count], axis=1), dtype=np.int64)

@@ -15,39 +15,33 @@ Two builds make the same tree, number for number (tests/test_bvh.py):
   contiguous rows.
 - `levels`, per node and per primitive (python and compiled variants, rtcli/variants.py):
   the compiled one builds 100,000 triangles' tree in a few hundredths of a second.
-`build` takes the compiled one when its machine code file is at hand (rtcli/machinecode.py:
-no numba needed) or numba is already loaded (a render loads it for its walks anyway), so
-that checking a scene never waits for numba to start.
+`build` runs `levels` when it is given a runner of it (the compiled variant, from its machine
+code file or numba: rtcli/compiled/build.py, which the engine choice, rendering/engine.py,
+hands to whatever builds trees for a render), and the numpy build otherwise.
 """
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 
-from rtcli import machinecode, variants
 from rtcli.variants import INF, per_ray
 
 
-def build(lo, hi, leaf_size, bins):
+def build(lo, hi, leaf_size, bins, levels=None):
     """The flat node arrays (lo, hi, child, start, count), perm and the tree's depth.
 
-    lo, hi: (m, 3) primitive boxes; the node boxes come back as (k, 3) arrays.
+    lo, hi: (m, 3) primitive boxes; the node boxes come back as (k, 3) arrays. `levels`: a
+    runner of `levels` (levels_build), else the numpy build.
     """
-    if variants.ENABLED and len(lo) > leaf_size and ("numba" in sys.modules or machinecode.load(LEVELS)):
-        return compiled_build(lo, hi, leaf_size, bins)
+    if levels is not None and len(lo) > leaf_size:
+        return levels_build(lo, hi, leaf_size, bins, levels)
     return numpy_build(lo, hi, leaf_size, bins)
 
 
-LEVELS = "levels"                 # the machine code file of `levels` (rtcli/machinecode.py)
-
-
-def compiled_build(lo, hi, leaf_size, bins, variant=None):
-    """`levels` run by its compiled variant: its machine code file when there is one, else numba
-    (or by `variant`, say variants.python(levels))."""
+def levels_build(lo, hi, leaf_size, bins, run):
+    """The tree `levels` builds, run by `run` (a variant of it: the compiled one, or
+    variants.python(levels))."""
     args = levels_args(lo, hi, leaf_size, bins)
-    run = variant or machinecode.entry(LEVELS, lambda: variants.compiled(levels), args)
     nodes, depth = run(*args)
     n_lo, n_hi, child, start, count, perm = args[4:10]
     return n_lo[:nodes], n_hi[:nodes], child[:nodes], start[:nodes], count[:nodes], perm, int(depth)

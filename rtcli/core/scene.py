@@ -98,6 +98,7 @@ class Scene:
     settings: Settings = field(default_factory=Settings)
     eye: np.ndarray = field(default_factory=lambda: np.zeros(3))
     accel: object = None             # the numpy engine's rtcli.wavefront.accel.Accelerator, when built
+    walks: object = None             # the numpy engine's compiled BVH walks (rtcli.compiled.walks.Walks), if given
 
     @functools.cached_property
     def boxes(self) -> Boxes:
@@ -129,9 +130,9 @@ class Scene:
         return np.array([light.row for light in self.lights]).reshape(-1, 22)
 
 
-def object_tree(scene: Scene) -> tuple[np.ndarray, BVH]:
+def object_tree(scene: Scene, levels=None) -> tuple[np.ndarray, BVH]:
     """(members, BVH): the scene's bounded objects and a BVH over their world boxes, as both
-    engines walk it."""
+    engines walk it (`levels`: core/bvh_build.py)."""
     boxes = scene.boxes
     members = np.flatnonzero(boxes.bounded)
-    return members, BVH(boxes.lo[members], boxes.hi[members], leaf_size=2)
+    return members, BVH(boxes.lo[members], boxes.hi[members], leaf_size=2, levels=levels)

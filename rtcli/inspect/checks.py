@@ -118,14 +118,14 @@ def _camera_sees_something(scene: Scene) -> bool:
     centre, SMALL then LARGER pixels on the image's long side, hits one (the signature render's
     test). The cheap proofs come first (boxes, then the unbounded objects such as a floor, which
     every ray is tested against anyway), so a render's check rarely traces the whole scene."""
-    from rtcli import wavefront
+    from rtcli.rendering import engine  # start-up: validate of a plain scene traces nothing
     s = scene.settings
     if _wholly_in_view(scene, scene.camera(s.width, s.height)):
         return True
     unbounded = np.flatnonzero(~scene.boxes.bounded)
     if len(unbounded) and _signature_hits(scene, SMALL, unbounded):
         return True
-    wavefront.prepare(scene)
+    engine.numpy_engine(scene)
     return any(_signature_hits(scene, size) for size in (SMALL, LARGER)
                if size == SMALL or max(s.width, s.height) > SMALL)
 

@@ -25,7 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.core.display import to_8bit
-from rtcli.rendering.tiles import Job, blank, place, prepare, render_tile
+from rtcli.rendering.engine import prepare
+from rtcli.rendering.tiles import Job, blank, place, render_tile
 from rtcli.stats import Stats
 
 PASSES = (16, 8, 4, 2, 1)          # one ray per B x B block, pass by pass

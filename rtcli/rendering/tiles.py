@@ -5,8 +5,8 @@ bounded by the tile size whatever the image size. Tiles go to worker processes;
 every pixel's value depends only on the pixel (jitter is hashed from its
 coordinates), so the image is the same for any tile size and worker count.
 With `block_size` B, one ray goes through the top-left pixel of each B x B block
-and the whole block gets its color (002's raytrace loop). Job.engine picks the
-numpy engine (rtcli/wavefront/) or the compiled one (rtcli/compiled/) to trace the rays.
+and the whole block gets its color (002's raytrace loop). Job.engine asks for the
+numpy engine (rtcli/wavefront/) or the compiled one (rtcli/compiled/); engine.py decides.
 """
 
 from __future__ import annotations
@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli import compiled, variants, wavefront
 from rtcli.core.display import to_8bit
 from rtcli.core.jitter import sample_positions
 from rtcli.core.scene import Scene
+from rtcli.rendering import engine as engines
 from rtcli.rendering.pool import held_signals, stop_pool, watch_worker, worker_died
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
@@ -43,13 +43,13 @@ class Job:
     tile: int = TILE
     signature: bool = False          # trace primary rays only and return object ids
     gamma: bool = False              # sRGB-encode when converting to 8 bits
-    engine: str = "auto"             # auto, numpy or compiled (see rtcli.compiled.choose)
+    engine: str = "auto"             # auto, numpy or compiled (rtcli/rendering/engine.py)
     bvh: bool = True                 # a BVH over the scene's objects when there are enough (Scene.wants_bvh)
     linear: bool = False             # keep the traced colors (float64, unclamped) instead of 8 bits
 
 
 def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
-                engine: compiled.Compiled | None = None) -> tuple[np.ndarray, Stats]:
+                engine=None) -> tuple[np.ndarray, Stats]:
     """Colors (or ids) of the pixels (i, j) of the full-size image; a compiled `engine` traces
     them instead of the numpy engine when given. The kernels make inf and NaN on purpose (a
     ray parallel to a plane, a miss), so numpy's warnings about them are off."""
@@ -117,7 +117,7 @@ def render(scene: Scene, job: Job, workers: int = 1, progress=None, notes=None) 
     it compiles (default: stderr).
     """
     tiles, traced = plan(scene, job)
-    stats, (engine, load) = Stats(), prepare(scene, job, traced, notes)
+    stats, (engine, load) = Stats(), engines.prepare(scene, job, traced, notes)
     stats.engine = "compiled" if engine else "numpy"            # add() keeps it
     if load:
         stats.load_seconds, stats.compile_seconds = load.seconds, load.compile_seconds
@@ -150,33 +150,6 @@ def plan(scene: Scene, job: Job) -> tuple[list, int]:
     """(tiles, primary rays the whole job traces): the tiles' (rows, cols) index ranges."""
     tiles = list(_tiles(job, 1 if job.signature else scene.settings.samples))
     return tiles, sum(len(r) * len(c) for r, c in tiles) * scene.settings.samples ** 2
-
-
-def prepare(scene: Scene, job: Job, traced: int, notes=None):
-    """(engine, load): the compiled engine for the job (rtcli.compiled.choose), or None with the
-    scene readied for the numpy engine; and how long loading compiled code took (None when
-    nothing was loaded). `notes` is told when it compiles."""
-    engine = None if job.signature else compiled.choose(scene, job.engine, _weighed(scene, job, traced), job.bvh,
-                                                         notes)
-    if engine:
-        return engine, engine.load
-    return None, wavefront.prepare(scene, job.bvh, notes)
-
-
-def _weighed(scene: Scene, job: Job, traced: int) -> int:
-    """The rays `auto` weighs: a small job takes the numpy engine to spare numba's start-up, unless
-    the compiled engine starts without numba (its machine code file), or the numpy engine would
-    load compiled BVH walks anyway (meshes, sets of spheres) and the integrator
-    is cached: then the compiled engine starts as fast and traces faster, so the job counts as a
-    large one. (Not cached, it would compile for a minute; the walks compile in seconds.)"""
-    if job.engine != "auto" or traced >= compiled.AUTO_RAYS or not variants.ENABLED:
-        return traced
-    if compiled.starts_at_once():
-        return compiled.AUTO_RAYS
-    wavefront.build(scene, job.bvh)
-    if wavefront.uses_compiled_walks(scene) and compiled.ready_to_load():
-        return compiled.AUTO_RAYS
-    return traced
 
 
 def run_tiles(scene: Scene, engine, job: Job, tiles: list) -> list:

@@ -1,6 +1,6 @@
 """A scene given as plain Python data (the dict a scene file loads into), located by key path.
 
-The Python API (rtcli/api.py) accepts a scene as a dict of dicts, lists, strings,
+The Python API (rtcli/api/) accepts a scene as a dict of dicts, lists, strings,
 numbers, booleans and None: what `yaml.safe_load` of a scene file gives. It becomes
 the same MapNode/SeqNode tree a file gives (nodes.py), so every check and message
 is the one a file gets; a dict has no lines, so its nodes are located at line 0

@@ -74,10 +74,15 @@ class Mesh(Shape):
 
     @property
     def bvh(self) -> BVH:
-        """The BVH over the faces' boxes, built when first asked for: checking a scene needs only
-        its bounds, and a render builds it after numba has loaded (core/bvh_build.py)."""
+        """The BVH over the faces' boxes, built when first asked for (checking a scene needs only
+        its bounds), by numpy unless a render built it first (tree)."""
+        return self.tree()
+
+    def tree(self, levels=None) -> BVH:
+        """The BVH over the faces' boxes, built now if it was not, by `levels` when given (the
+        compiled build the engine choice hands a render: core/bvh_build.py)."""
         if self._bvh is None:
-            self._bvh, self._boxes = BVH(*self._boxes), None
+            self._bvh, self._boxes = BVH(*self._boxes, levels=levels), None
         return self._bvh
 
     def bounds(self):

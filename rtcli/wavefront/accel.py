@@ -6,15 +6,14 @@ pairs whose boxes the ray meets, and only those pairs are intersected. Spheres
 without a transform, the common case in big scenes, are tested as one
 vectorized batch per step (the sphere kernels take one row of parameters per
 ray); other objects are grouped per object. When every bounded object is such a
-sphere and numba is installed, the compiled per-ray walk of rtcli/core/bvh.py
-does the whole BVH part instead.
+sphere and the scene was given compiled walks (Scene.walks: rendering/engine.py gives them
+when numba is installed), the per-ray walk of rtcli/core/bvh.py does the whole BVH part.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from rtcli import variants
 from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.scene import object_tree
 from rtcli.core.vec import unit
@@ -33,17 +32,16 @@ from rtcli.wavefront.intersect import (
 class Accelerator:
     """The scene's unbounded objects, and a BVH over its bounded ones."""
 
-    def __init__(self, scene):
+    def __init__(self, scene, levels=None):
         objects, bounded = scene.objects, scene.boxes.bounded
         self.unbounded = np.flatnonzero(~bounded)
-        self.members, self.bvh = object_tree(scene)
+        self.members, self.bvh = object_tree(scene, levels)
         self.is_sphere = np.array([type(o.shape) is Sphere and o.transform is None for o in objects],
                                   dtype=bool) & bounded                              # by object index
         self.spheres = np.array([o.shape.row if s else np.zeros(5) for o, s in zip(objects, self.is_sphere)]).T
         self.material = np.array([o.material for o in objects], dtype=np.int64)
         self.shadow = scene.materials.shadow[self.material]
         self.all_spheres = bool(self.is_sphere[self.members].all())    # the compiled walk can do it all
-        self._geometry = None
 
     def batched(self, obj: np.ndarray) -> np.ndarray:
         """Which hits (object indices, -1 none) are on untransformed spheres."""
@@ -71,7 +69,7 @@ class Accelerator:
         for k in np.unique(obj[rest]):
             rows = rest[obj[rest] == k]
             t[rows], prim[rows] = object_hit(scene.objects[k], o[:, r[rows]], d[:, r[rows]],
-                                             low if low.ndim == 0 else low[rows], t_max[rows])
+                                             low if low.ndim == 0 else low[rows], t_max[rows], scene.walks)
         return t, prim
 
     def _pair_blocks(self, scene, o, d, r, m):
@@ -84,30 +82,16 @@ class Accelerator:
         rest = np.flatnonzero(self.shadow[obj] & ~sph)
         for k in np.unique(obj[rest]):
             rows = rest[obj[rest] == k]
-            blocked[rows] = blocks(scene.objects[k], o[:, r[rows]], d[:, r[rows]], 0.0, 1.0)
+            blocked[rows] = blocks(scene.objects[k], o[:, r[rows]], d[:, r[rows]], 0.0, 1.0, scene.walks)
         return select(blocked, 0.5, INF)
-
-    def compiled_walk(self, scene, o, d, t_min, t_max, mode: int):
-        """The compiled walk over the scene's tree: (t, object, prim) per ray (mode: core/bvh.py)."""
-        from rtcli.compiled import query
-        from rtcli.compiled.pack import geometry
-        if self._geometry is None:
-            self._geometry = geometry(scene, tree=True, bvh=(self.members, self.bvh))
-        geo, depth = self._geometry
-        n = o.shape[1]
-        t, obj, prim = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
-        lo, hi = (np.broadcast_to(np.asarray(x, float), (n,)).copy() for x in (t_min, t_max))
-        query.WALK_RAYS_OBJECTS(geo, 0, np.ascontiguousarray(o), np.ascontiguousarray(d), lo, hi, mode,
-                                t, obj, prim, np.empty(depth, np.int64))
-        return t, obj, prim
 
     def first_hit(self, scene, rays, t_min, t_max=np.inf, casters: bool = False):
         """find_first_hit through the BVH (with `casters`, among the objects that cast shadows)."""
         o, d = rays.o, rays.d
         hits = no_hits(len(rays), t_max)
         nearest_over(scene, self.unbounded, rays, t_min, hits, casters)
-        if variants.ENABLED and self.all_spheres:
-            t, obj, sub = self.compiled_walk(scene, o, d, t_min, hits.t, NEAREST_CASTER if casters else NEAREST)
+        if scene.walks is not None and self.all_spheres:
+            t, obj, sub = scene.walks.objects(self, scene, o, d, t_min, hits.t, NEAREST_CASTER if casters else NEAREST)
             won = obj >= 0
             hits.t[won], hits.obj[won], hits.prim[won] = t[won], obj[won], sub[won]
             return hits
@@ -125,8 +109,8 @@ class Accelerator:
         blocked_by(scene, self.unbounded, points, d, blocked)
         todo = np.flatnonzero(~blocked)
         p, dt = points[:, todo], d[:, todo]
-        if variants.ENABLED and self.all_spheres:
-            blocked[todo] = self.compiled_walk(scene, p, dt, 0.0, 1.0, ANY_CASTER)[1] >= 0
+        if scene.walks is not None and self.all_spheres:
+            blocked[todo] = scene.walks.objects(self, scene, p, dt, 0.0, 1.0, ANY_CASTER)[1] >= 0
         else:
             blocked[todo] = self.bvh.any_hit(p, dt, 0.0, 1.0, lambda r, m, t_max: self._pair_blocks(scene, p, dt, r, m))
         return blocked

@@ -9,13 +9,11 @@ kernels. Vectors are components (3, n).
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli import variants
-from rtcli.core.bvh import ANY_CASTER, NEAREST, slab
+from rtcli.core.bvh import slab
 from rtcli.core.dielectric import FEELER_CROSSINGS
 from rtcli.core.scene import Scene
 from rtcli.core.shading import facing
@@ -54,44 +52,25 @@ def to_object(obj, o, d):
     return np.array(c[:3]), np.array(c[3:])
 
 
-_GEOMETRY = weakref.WeakKeyDictionary()              # meshes packed for the compiled walk
+def walked_mesh(shape, walks) -> bool:
+    """Whether the shape is hit through a BVH over pool triangles (a mesh) and `walks` (Scene.walks,
+    the compiled walks, when the engine choice gave them) walks it."""
+    return walks is not None and shape.kernels is not None and shape.kernels.hit is None
 
 
-def _walks_triangles(shape) -> bool:
-    """Whether the shape is hit through a BVH over pool triangles (a mesh), and the compiled walk
-    can do it (numba installed)."""
-    return shape.kernels is not None and shape.kernels.hit is None and variants.ENABLED
-
-
-def compiled_walk(shape, o, d, t_min, t_max, shadow: bool):
-    """The compiled walk over a mesh's tree for rays o, d (3, n): (t, face) or the blocked mask."""
-    from rtcli.compiled import query
-    from rtcli.compiled.pack import mesh_geometry
-    n = o.shape[1]
-    if shape not in _GEOMETRY:
-        _GEOMETRY[shape] = mesh_geometry(shape)
-    geo = _GEOMETRY[shape]
-    t, face, prim = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
-    lo, hi = (np.broadcast_to(np.asarray(x, float), (n,)).copy() for x in (t_min, t_max))
-    query.WALK_RAYS_TRIANGLES(geo, 0, np.ascontiguousarray(o), np.ascontiguousarray(d), lo, hi,
-                              ANY_CASTER if shadow else NEAREST,
-                              t, face, prim, np.empty(shape.bvh.depth + 2, np.int64))
-    return (face >= 0) if shadow else (t, face)
-
-
-def object_hit(obj, o, d, t_min, t_max):
-    """(t, prim) of one scene object for rays o + t d in world space."""
+def object_hit(obj, o, d, t_min, t_max, walks=None):
+    """(t, prim) of one scene object for rays o + t d in world space (`walks`: Scene.walks)."""
     o_obj, d_obj = to_object(obj, o, d)
-    if _walks_triangles(obj.shape):
-        return compiled_walk(obj.shape, o_obj, d_obj, t_min, t_max, False)
+    if walked_mesh(obj.shape, walks):
+        return walks.mesh(obj.shape, o_obj, d_obj, t_min, t_max, False)
     return obj.shape.hits(o_obj, d_obj, t_min, t_max)
 
 
-def blocks(obj, o, d, t_min, t_max) -> np.ndarray:
+def blocks(obj, o, d, t_min, t_max, walks=None) -> np.ndarray:
     """(n,) bool: the rays o + t d hit object obj for t_min < t < t_max (any hit will do)."""
     o_obj, d_obj = to_object(obj, o, d)
-    if _walks_triangles(obj.shape):
-        return compiled_walk(obj.shape, o_obj, d_obj, t_min, t_max, True)
+    if walked_mesh(obj.shape, walks):
+        return walks.mesh(obj.shape, o_obj, d_obj, t_min, t_max, True)
     if hasattr(obj.shape, "any_hit"):                  # meshes stop at their first blocking triangle
         return obj.shape.any_hit(o_obj, d_obj, t_min, t_max)
     return np.isfinite(obj.shape.hits(o_obj, d_obj, t_min, t_max)[0])
@@ -129,7 +108,7 @@ def nearest_over(scene: Scene, indices, rays: Rays, t_min, best: Hits, casters: 
         rows = _candidates(scene, k, rays.o, inv, every, best.t)
         if len(rows):
             low = t_min if t_min.ndim == 0 else t_min[rows]
-            t, prim = object_hit(scene.objects[k], rays.o[:, rows], rays.d[:, rows], low, best.t[rows])
+            t, prim = object_hit(scene.objects[k], rays.o[:, rows], rays.d[:, rows], low, best.t[rows], scene.walks)
             closer = t < best.t[rows]
             won = rows[closer]
             best.t[won], best.obj[won], best.prim[won] = t[closer], k, prim[closer]
@@ -143,7 +122,7 @@ def blocked_by(scene: Scene, indices, points: np.ndarray, d: np.ndarray, blocked
         if casts(scene, k):
             todo = _candidates(scene, k, points, inv, np.flatnonzero(~blocked), 1.0)
             if len(todo):
-                blocked[todo] = blocks(scene.objects[k], points[:, todo], d[:, todo], 0.0, 1.0)
+                blocked[todo] = blocks(scene.objects[k], points[:, todo], d[:, todo], 0.0, 1.0, scene.walks)
 
 
 def no_hits(n: int, t_max=np.inf) -> Hits:

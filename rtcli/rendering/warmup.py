@@ -15,19 +15,24 @@ from functools import partial
 
 import numpy as np
 
-from rtcli import machinecode, variants
-from rtcli.compiled.loading import Load, ready
+from rtcli import machinecode, variants, wavefront
+from rtcli.compiled import ENTRY, compiled_integrator
+from rtcli.compiled import build as compiled_build
+from rtcli.compiled.loading import Load
+from rtcli.core.bvh_build import levels, levels_args
+from rtcli.core.camera import from_fov
+from rtcli.core.lights import PointLight
+from rtcli.core.materials import Material, MaterialTable
+from rtcli.core.scene import Scene, SceneObject
+from rtcli.errors import RtcliError
+from rtcli.rendering.engine import choose
+from rtcli.shapes.mesh import Mesh
+from rtcli.shapes.plane import Plane
+from rtcli.shapes.sphere import Sphere
 
 
 def _scenes():
     """(nine spheres over a plane: the integrator with a BVH, the walk over spheres; a mesh)."""
-    from rtcli.core.camera import from_fov
-    from rtcli.core.lights import PointLight
-    from rtcli.core.materials import Material, MaterialTable
-    from rtcli.core.scene import Scene, SceneObject
-    from rtcli.shapes.mesh import Mesh
-    from rtcli.shapes.plane import Plane
-    from rtcli.shapes.sphere import Sphere
     camera = partial(from_fov, np.array([0.0, 2, 8]), np.zeros(3), [0, 1, 0], 40.0)
     lights = [PointLight(np.array([4.0, 6, 4]), np.ones(3), np.array([1.0, 0, 0]))]
     spheres = [SceneObject(k + 1, "", Sphere((k % 3 - 1.0, 0.5, k // 3 - 1.0), 0.4), 0) for k in range(9)]
@@ -43,31 +48,27 @@ def warmup(notes=None) -> tuple[list[tuple[str, Load]], tuple[list[str], str | N
     render engine and the numpy engine's walks, and the entries with a machine code file and why
     one is missing (machine_code). `notes` hears when one compiles (default: stderr). RtcliError when numba
     cannot be loaded."""
-    from rtcli import compiled, wavefront
-    from rtcli.errors import RtcliError
     if not variants.ENABLED:
         raise RtcliError("numba is not installed: nothing to compile (the numpy engine needs none; "
                          "pip install -e '.[fast]' in the rtcli folder for the compiled engine)")
+    from rtcli.compiled.walks import WALKS, Walks, warm_up  # start-up: numba
     spheres, mesh = _scenes()
-    engine = compiled.choose(spheres, "compiled", notes=notes)
+    engine = choose(spheres, "compiled", notes=notes)
     start, found = time.perf_counter(), []
     for scene in (spheres, mesh):
         wavefront.build(scene)
-        found.append(wavefront.walks(scene))
-    entries = [e for scene_entries, _ in found for e in scene_entries]
-    walks = ready(entries, lambda: [call() for _, call in found], wavefront.WALKS, "about half a minute", notes, start)
-    return [("the render engine (compiled)", engine.load), (wavefront.WALKS, walks)], machine_code(engine)
+        found.append(Walks().calls(scene, *wavefront.walked(scene)))
+    walks = warm_up(found, notes, start)
+    return [("the render engine (compiled)", engine.load), (WALKS, walks)], machine_code(engine)
 
 
 def machine_code(engine) -> tuple[list[str], str | None]:
     """Write the machine code files (rtcli/machinecode.py) of the integrator and of the BVH build,
     unless they are at hand and fit (`engine`: a Compiled, whose arguments the file takes): the
     entries that have a usable file afterwards, and why one could not be written (or None)."""
-    from rtcli.compiled import ENTRY, _trace_camera
-    from rtcli.core.bvh_build import LEVELS, levels, levels_args
     why, found = None, machinecode.load(ENTRY)
     if found is None or not found.fits(engine.empty_call):
-        why = machinecode.make(ENTRY, _trace_camera(), engine.empty_call)
+        why = machinecode.make(ENTRY, compiled_integrator(), engine.empty_call)
     if machinecode.load(LEVELS) is None:
         lo = np.random.default_rng(0).random((64, 3))
         args = levels_args(lo, lo + 0.1, 2, 12)
@@ -75,6 +76,9 @@ def machine_code(engine) -> tuple[list[str], str | None]:
         run(*args)
         why = machinecode.make(LEVELS, run, args, results=2) or why
     return [name for name in (ENTRY, LEVELS) if machinecode.load(name) is not None], why
+
+
+LEVELS = compiled_build.LEVELS
 
 
 def bytecode() -> bool:
