@@ -22,9 +22,10 @@ def warmup(cluster, cluster_file, local_cluster):
         from rtcli.cluster.warm import warm  # start-up: Dask only when asked
         with where:
             return warm(where.session(), click.echo)
-    from rtcli import machinecode, variants  # start-up
+    from rtcli import variants  # start-up
     from rtcli.compiled.warmup import bytecode
     from rtcli.compiled.warmup import warmup as warm
+    from rtcli.kernels import machinecode  # start-up
     start = time.perf_counter()
     machinecode.report_to(lambda text: click.echo(f"note: {text}", err=True))
     where = variants.cache_location() if variants.ENABLED else None

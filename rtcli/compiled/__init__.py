@@ -33,11 +33,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rtcli import machinecode, variants
+from rtcli import variants
 from rtcli.compiled.loading import Load, cached, ready, say
 from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
+from rtcli.kernels import machinecode
 from rtcli.stats import Stats
 
 __all__ = ["AUTO_RAYS", "Compiled", "Load", "choose", "unsupported"]

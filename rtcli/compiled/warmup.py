@@ -15,8 +15,9 @@ from functools import partial
 
 import numpy as np
 
-from rtcli import machinecode, variants
+from rtcli import variants
 from rtcli.compiled.loading import Load, ready
+from rtcli.kernels import machinecode
 
 
 def _scenes():

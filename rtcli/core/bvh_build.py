@@ -15,7 +15,7 @@ Two builds make the same tree, number for number (tests/test_bvh.py):
   contiguous rows.
 - `levels`, per node and per primitive (python and compiled variants, rtcli/variants.py):
   the compiled one builds 100,000 triangles' tree in a few hundredths of a second.
-`build` takes the compiled one when its machine code file is at hand (rtcli/machinecode.py:
+`build` takes the compiled one when its machine code file is at hand (rtcli/kernels/machinecode:
 no numba needed) or numba is already loaded (a render loads it for its walks anyway), so
 that checking a scene never waits for numba to start.
 """
@@ -26,7 +26,8 @@ import sys
 
 import numpy as np
 
-from rtcli import machinecode, variants
+from rtcli import variants
+from rtcli.kernels import machinecode
 from rtcli.variants import INF, per_ray
 
 
@@ -40,7 +41,7 @@ def build(lo, hi, leaf_size, bins):
     return numpy_build(lo, hi, leaf_size, bins)
 
 
-LEVELS = "levels"                 # the machine code file of `levels` (rtcli/machinecode.py)
+LEVELS = "levels"                 # the machine code file of `levels` (rtcli/kernels/machinecode)
 
 
 def compiled_build(lo, hi, leaf_size, bins, variant=None):
@@ -70,7 +71,7 @@ def scratch(lo, hi, bins: int) -> tuple:
     level in node order (work) with their boxes (p_lo, p_hi), the same three for the next level, the
     node sizes and bounds of this level and the next, and per node the bins' counts and boxes, the
     counts and areas right of each cut and the bins' scale per axis. The caller makes them, so that
-    `levels` allocates nothing (it runs as machine code without numba: rtcli/machinecode.py)."""
+    `levels` allocates nothing (it runs as machine code without numba: rtcli/kernels/machinecode)."""
     m = len(lo)
     return (np.arange(m), lo.copy(), hi.copy(), np.empty(m, dtype=np.int64), np.empty((m, 3)), np.empty((m, 3)),
             np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64), np.empty((m, 4, 3)), np.empty((m, 4, 3)),
