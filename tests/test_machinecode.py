@@ -110,6 +110,31 @@ def test_a_file_made_for_another_process_is_not_used(small, place, field, value)
     assert machinecode.load("small") is None
 
 
+def test_the_switch_leaves_a_file_unused(small, monkeypatch):
+    """RTCLI_MACHINE_CODE=0: a file made for this process is not loaded, and none is written."""
+    assert machinecode.load("small") is not None
+    monkeypatch.setattr(places, "ENABLED", False)
+    entries._loaded.clear()
+    assert machinecode.load("small") is None
+    assert machinecode.make("small", small, small_args(), results=2) == "RTCLI_MACHINE_CODE=0"
+
+
+def test_the_key_covers_every_file_of_this_package(tmp_path):
+    """The machine code is made by this package too (the wrapper, the stubs, the checks): a
+    change to any of its files is another key."""
+    copy = tmp_path / places.HERE.name
+    shutil.copytree(places.HERE, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    digest = places.sources_digest(tmp_path, (copy.name,))
+    assert places.key()["sources"] == places.sources_digest() + digest[:16]
+    files = sorted(copy.glob("*.py"))
+    assert {f.name for f in files} >= {"__init__.py", "entries.py", "places.py", "writing.py"}
+    for f in files:
+        kept = f.read_bytes()
+        f.write_bytes(kept + b"\n")
+        assert places.sources_digest(tmp_path, (copy.name,)) != digest, f.name
+        f.write_bytes(kept)
+
+
 def test_the_cpu_is_told_by_its_model_and_flags():
     info = "processor\t: 0\nvendor_id\t: AuthenticAMD\nmodel name\t: AMD EPYC 9B14\nflags\t\t: fpu sse2 avx2{}\n\n" \
            "processor\t: 1\n"
@@ -391,7 +416,9 @@ def test_a_second_file_replaces_the_first_whole(small, place):
     libraries = list(place.glob("rtcli-small-*.so"))
     assert len(libraries) == 1 and json.loads(machinecode.description_file("small", place).read_text())[
         "library"] == libraries[0].name
-    assert machinecode.load("small")(*small_args()) == (4, 4) and first(*small_args()) == (4, 4)
+    again = machinecode.load("small")
+    assert again is not first                                          # the new pair is read, not the old kept
+    assert again(*small_args()) == (4, 4) and first(*small_args()) == (4, 4)
 
 
 ERROR_PATH = """
