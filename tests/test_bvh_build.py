@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 from bvh_reference import build as reference_build
 
-from rtcli import machinecode, variants
+from rtcli import variants
 from rtcli.compiled import build as compiled_build
 from rtcli.core import bvh_build
 from rtcli.core.bvh import BVH
+from rtcli.kernels import machinecode
 from rtcli.scenefile.obj import read_obj
 from rtcli.shapes.mesh import Mesh
 

@@ -17,8 +17,10 @@ import pytest
 from PIL import Image
 
 from rtcli import compiled as fast
-from rtcli import machinecode, variants
+from rtcli import variants
 from rtcli.compiled import build as compiled_build
+from rtcli.kernels import machinecode
+from rtcli.kernels.machinecode import entries, places, writing
 from rtcli.rendering.engine import choose
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
@@ -29,8 +31,8 @@ SCENE = ROOT / "scenes" / "whitted.yaml"
 RENDER = """
 import sys
 from pathlib import Path
-from rtcli import machinecode
-machinecode.folder = lambda: Path(sys.argv[1])
+from rtcli.kernels.machinecode import places
+places.folder = lambda: Path(sys.argv[1])
 from rtcli.cli import main
 main(["render", sys.argv[2], "-o", sys.argv[3], "--width", "48", "--height", "36", "--engine", "compiled",
       "--stats", "--quiet"])
@@ -51,7 +53,7 @@ def files():
     if machinecode.folder() is None:
         pytest.skip("no cache folder")
     from rtcli.rendering.warmup import _scenes, machine_code
-    machinecode._loaded.clear()
+    entries._loaded.clear()
     made, why = machine_code(choose(_scenes()[0], "compiled", notes=lambda text: None))
     assert made == [fast.ENTRY, compiled_build.LEVELS], why
     return machinecode.folder()
@@ -83,7 +85,7 @@ def planted_library(place: Path, marker: Path) -> Path:
     source.write_text(PLANTED.format(marker=marker))
     about = json.loads(machinecode.description_file(fast.ENTRY, place).read_text())
     library = place / about["library"]
-    subprocess.run([*machinecode.compiler(), "-shared", "-fPIC", "-o", str(library), str(source)], check=True)
+    subprocess.run([*writing.compiler(), "-shared", "-fPIC", "-o", str(library), str(source)], check=True)
     return library
 
 
@@ -130,7 +132,7 @@ CASES = {                                # what is done to the copy of the files
     "a FIFO for the description": (lambda place, library, about, marker: fifo(about), "is not a regular file"),
     "a description naming a helper": (
         lambda place, library, about, marker: about.write_text(about.read_text().replace(
-            f'"symbol": "{machinecode.ENTRY_SYMBOL}"', '"symbol": "numba_do_raise"')), "names 'numba_do_raise'"),
+            f'"symbol": "{places.ENTRY_SYMBOL}"', '"symbol": "numba_do_raise"')), "names 'numba_do_raise'"),
 }
 
 

@@ -1,4 +1,4 @@
-"""Machine code files (rtcli/machinecode.py): the compiled entry points run without numba give
+"""Machine code files (rtcli/kernels/machinecode): the compiled entry points run without numba give
 numba's numbers, and a file is used only by a process it was made for."""
 
 from __future__ import annotations
@@ -16,9 +16,11 @@ import numpy as np
 import pytest
 
 from rtcli import compiled as fast
-from rtcli import machinecode, variants
+from rtcli import variants
 from rtcli.compiled import build as compiled_build
 from rtcli.core import bvh_build
+from rtcli.kernels import machinecode
+from rtcli.kernels.machinecode import arguments, entries, flow, llvmir, places, trust, writing
 from rtcli.rendering.engine import choose
 from rtcli.rendering.tiles import Job, render_tile
 from rtcli.scenefile.load import load_scene
@@ -39,8 +41,8 @@ def small_body(pair, out, k, x, flag):
 @pytest.fixture
 def place(tmp_path, monkeypatch):
     """Machine code files made and read in a folder of their own."""
-    monkeypatch.setattr(machinecode, "folder", lambda: tmp_path)
-    monkeypatch.setattr(machinecode, "_loaded", {})
+    monkeypatch.setattr(places, "folder", lambda: tmp_path)
+    monkeypatch.setattr(entries, "_loaded", {})
     return tmp_path
 
 
@@ -99,7 +101,7 @@ def edit_description(place, name, change):
     description = json.loads(about.read_text())
     change(description)
     about.write_text(json.dumps(description))
-    machinecode._loaded.clear()
+    entries._loaded.clear()
 
 
 @pytest.mark.parametrize("field, value", [("sources", "0" * 64), ("cpu", "another-cpu"), ("numba", "0.1"),
@@ -110,14 +112,39 @@ def test_a_file_made_for_another_process_is_not_used(small, place, field, value)
     assert machinecode.load("small") is None
 
 
+def test_the_switch_leaves_a_file_unused(small, monkeypatch):
+    """RTCLI_MACHINE_CODE=0: a file made for this process is not loaded, and none is written."""
+    assert machinecode.load("small") is not None
+    monkeypatch.setattr(places, "ENABLED", False)
+    entries._loaded.clear()
+    assert machinecode.load("small") is None
+    assert machinecode.make("small", small, small_args(), results=2) == "RTCLI_MACHINE_CODE=0"
+
+
+def test_the_key_covers_every_file_of_this_package(tmp_path):
+    """The machine code is made by this package too (the wrapper, the stubs, the checks): a
+    change to any of its files is another key."""
+    copy = tmp_path / places.HERE.name
+    shutil.copytree(places.HERE, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    digest = places.sources_digest(tmp_path, (copy.name,))
+    assert places.key()["sources"] == places.sources_digest() + digest[:16]
+    files = sorted(copy.glob("*.py"))
+    assert {f.name for f in files} >= {"__init__.py", "entries.py", "places.py", "writing.py"}
+    for f in files:
+        kept = f.read_bytes()
+        f.write_bytes(kept + b"\n")
+        assert places.sources_digest(tmp_path, (copy.name,)) != digest, f.name
+        f.write_bytes(kept)
+
+
 def test_the_cpu_is_told_by_its_model_and_flags():
     info = "processor\t: 0\nvendor_id\t: AuthenticAMD\nmodel name\t: AMD EPYC 9B14\nflags\t\t: fpu sse2 avx2{}\n\n" \
            "processor\t: 1\n"
-    plain, wide = machinecode.cpu(info.format("")), machinecode.cpu(info.format(" avx512f"))
+    plain, wide = places.cpu(info.format("")), places.cpu(info.format(" avx512f"))
     assert plain.startswith("cpuinfo ") and plain != wide                 # another CPU: another key
-    assert machinecode.cpu(info.format("")) == plain
+    assert places.cpu(info.format("")) == plain
     if os.path.exists("/proc/cpuinfo"):
-        assert machinecode.cpu().startswith("cpuinfo ")                    # read, not the fallback
+        assert places.cpu().startswith("cpuinfo ")                    # read, not the fallback
 
 
 def put_library(place, name, code: bytes, **changes) -> Path:
@@ -137,7 +164,7 @@ def build(tmp_path_factory):
         work = tmp_path_factory.mktemp("c")
         c, library = work / "library.c", work / "library.so"
         c.write_text(source)
-        subprocess.run([*machinecode.compiler(), "-shared", "-fPIC", "-o", str(library), str(c)], check=True)
+        subprocess.run([*writing.compiler(), "-shared", "-fPIC", "-o", str(library), str(c)], check=True)
         return library.read_bytes()
     return compile_c
 
@@ -154,10 +181,10 @@ def test_a_missing_or_broken_file_is_not_used(small, place):
     edit_description(place, "small", lambda d: d.update(library="rtcli-small-0000.so"))   # a pair half written
     assert machinecode.load("small") is None
     about.write_text("{")
-    machinecode._loaded.clear()
+    entries._loaded.clear()
     assert machinecode.load("small") is None
     about.unlink()
-    machinecode._loaded.clear()
+    entries._loaded.clear()
     assert machinecode.load("small") is None
     assert machinecode.load("never-made") is None
 
@@ -184,7 +211,7 @@ def notes():
     """What load says about the files it does not use."""
     heard = []
     machinecode.report_to(heard.append)
-    machinecode._told.clear()
+    entries._told.clear()
     yield heard
     machinecode.report_to(None)
 
@@ -248,27 +275,28 @@ def test_without_memory_files_a_private_copy_is_opened_and_removed(small, monkey
     folder, removed once open."""
     monkeypatch.delattr(os, "memfd_create")
     private = tmp_path_factory.mktemp("tmp")
-    monkeypatch.setattr(machinecode.tempfile, "tempdir", str(private))
-    kept = len(machinecode._kept)
+    monkeypatch.setattr(trust.tempfile, "tempdir", str(private))
+    kept = len(trust._kept)
     assert machinecode.load("small")(*small_args()) == (4, 4)
-    assert len(machinecode._kept) == kept and list(private.iterdir()) == []
+    assert len(trust._kept) == kept and list(private.iterdir()) == []
 
 
-def test_a_folder_that_is_a_link_to_this_users_folder_is_followed(small, place, tmp_path_factory):
+def test_a_folder_that_is_a_link_to_this_users_folder_is_followed(small, place, tmp_path_factory, monkeypatch):
     """The cache folder may be reached through a link (NUMBA_CACHE_DIR often is one): what is
     checked is the folder it leads to."""
     link = tmp_path_factory.mktemp("link") / "cache"
     link.symlink_to(place)
-    machinecode.folder = lambda: link
-    machinecode._loaded.clear()
+    monkeypatch.setattr(places, "folder", lambda: link)
+    entries._loaded.clear()
     assert machinecode.load("small")(*small_args()) == (4, 4)
 
 
 LOAD_ALONE = """
 import sys
 from pathlib import Path
-from rtcli import machinecode
-machinecode.folder = lambda: Path(sys.argv[1])
+from rtcli.kernels import machinecode
+from rtcli.kernels.machinecode import places
+places.folder = lambda: Path(sys.argv[1])
 machinecode.report_to(print)
 print(machinecode.load("small"))
 """
@@ -301,7 +329,7 @@ def test_a_truncated_or_corrupted_library_never_crashes(small, place):
     lines = load_alone(place)
     assert lines == [(f"machine code file not used, numba's path instead: {library.name} does not have the "
                       "SHA-256 recorded when it was written"), "None"]
-    assert machinecode.cut_short(code) is False
+    assert trust.cut_short(code) is False
 
 
 @pytest.mark.parametrize("which", ["library", "description"])
@@ -318,14 +346,14 @@ def test_a_fifo_in_place_of_a_file_does_not_hang(small, place, which):
 
 
 @pytest.mark.parametrize("symbol", ["numba_do_raise", "NRT_MemInfo_alloc", "NRT_decref", "abort",
-                                    machinecode.BODY_SYMBOL])
+                                    writing.BODY_SYMBOL])
 def test_a_description_naming_a_helper_as_its_entry_is_refused(small, place, notes, symbol):
     """Only rtcli's C function is ever called: not one of numba's helpers (or their stubs), nor a
     function of the C library the library links to."""
     edit_description(place, "small", lambda d: d.update(symbol=symbol))
     assert machinecode.load("small") is None
     assert notes == [(f"machine code file not used, numba's path instead: rtcli-small.json names {symbol!r} as "
-                      f"its entry, not {machinecode.ENTRY_SYMBOL}")]
+                      f"its entry, not {places.ENTRY_SYMBOL}")]
 
 
 def test_the_files_are_written_for_this_user_alone_whatever_the_umask(place):
@@ -370,13 +398,13 @@ def test_without_a_cache_a_c_compiler_or_the_switch_nothing_is_made(monkeypatch,
     body(*small_args())
     monkeypatch.setenv("CC", "false")
     assert machinecode.make("small", body, small_args(), results=2).startswith("the C compiler failed")
-    monkeypatch.setattr(machinecode, "compiler", lambda: None)
+    monkeypatch.setattr(writing, "compiler", lambda: None)
     assert machinecode.make("small", body, small_args(), results=2) == "no C compiler (cc) to link them"
-    monkeypatch.setattr(machinecode, "ENABLED", False)
+    monkeypatch.setattr(places, "ENABLED", False)
     assert machinecode.make("small", body, small_args(), results=2) == "RTCLI_MACHINE_CODE=0"
     assert machinecode.load("small") is None
-    monkeypatch.setattr(machinecode, "ENABLED", True)
-    monkeypatch.setattr(machinecode, "folder", lambda: None)
+    monkeypatch.setattr(places, "ENABLED", True)
+    monkeypatch.setattr(places, "folder", lambda: None)
     assert machinecode.make("small", body, small_args(), results=2) == "no cache folder"
     assert machinecode.load("small") is None
     assert not list(place.iterdir())                                   # nothing left behind
@@ -390,14 +418,17 @@ def test_a_second_file_replaces_the_first_whole(small, place):
     libraries = list(place.glob("rtcli-small-*.so"))
     assert len(libraries) == 1 and json.loads(machinecode.description_file("small", place).read_text())[
         "library"] == libraries[0].name
-    assert machinecode.load("small")(*small_args()) == (4, 4) and first(*small_args()) == (4, 4)
+    again = machinecode.load("small")
+    assert again is not first                                          # the new pair is read, not the old kept
+    assert again(*small_args()) == (4, 4) and first(*small_args()) == (4, 4)
 
 
 ERROR_PATH = """
 import sys
 import numpy as np
 from numba import njit
-from rtcli import machinecode
+from rtcli.kernels import machinecode
+from rtcli.kernels.machinecode import places
 sys.path.insert(0, {here!r})
 from test_machinecode import Pair
 
@@ -408,7 +439,7 @@ def raising(pair, out, k, x, flag):
     out[0] = x
     return 0, 0
 
-machinecode.folder = lambda: __import__("pathlib").Path({place!r})
+places.folder = lambda: __import__("pathlib").Path({place!r})
 args = (Pair(np.arange(4.0), 1.0), np.zeros(4), 1, 0.5, True)
 raising(*args)
 assert machinecode.make("raising", raising, args, results=2) is None
@@ -528,7 +559,7 @@ GIL_ENSURE = [("root", "numba_gil_ensure"), ("root", "PyErr_SetString"), ("root"
 def test_helper_calls_are_found_on_the_paths_that_raise_nothing(change, found):
     """numba's helpers may lie where a call raises (the blocks that only return an error status,
     or that a failed call's status leads to), nowhere else."""
-    assert machinecode.helper_calls(MODULE.format(**{**RAISING, **change}), "root") == found
+    assert flow.helper_calls(MODULE.format(**{**RAISING, **change}), "root") == found
 
 
 def test_the_engines_modules_call_numbas_helpers_only_where_they_raise(engine_files):
@@ -540,21 +571,21 @@ def test_the_engines_modules_call_numbas_helpers_only_where_they_raise(engine_fi
     levels = variants.compiled(bvh_build.levels)
     for name, body, args, results in [(fast.ENTRY, fast.compiled_integrator(), engine.empty_call, 0),
                                       (compiled_build.LEVELS, levels, bvh_build.levels_args(lo, lo + 0.1, 2, 12), 2)]:
-        _, module = machinecode._module(name, body, args, results)
+        _, module = writing._module(name, body, args, results)
         text = str(module)
-        assert machinecode.helper_calls(text, machinecode.BODY_SYMBOL) == [], name
-        functions, variables = machinecode.foreign_symbols(text)
+        assert flow.helper_calls(text, writing.BODY_SYMBOL) == [], name
+        functions, variables = llvmir.foreign_symbols(text)
         assert {"numba_gil_ensure", "numba_do_raise"} <= set(functions) and "PyExc_RuntimeError" in variables, name
 
 
 def test_numba_symbols_read_as_python_names():
-    assert machinecode.readable("_ZN5rtcli6shapes7polygon3hitB4v129B46c8tJTIeFI") == "rtcli.shapes.polygon.hit"
-    assert machinecode.readable("NRT_decref") == "NRT_decref"
+    assert llvmir.readable("_ZN5rtcli6shapes7polygon3hitB4v129B46c8tJTIeFI") == "rtcli.shapes.polygon.hit"
+    assert llvmir.readable("NRT_decref") == "NRT_decref"
 
 
 def test_the_wrapper_rebuilds_each_kind_of_argument():
-    source, tuples = machinecode.wrapper_source(
-        [(machinecode.layout(a), machinecode._classes(a)) for a in small_args()], 2)
+    source, tuples = arguments.wrapper_source(
+        [(arguments.layout(a), arguments.classes(a)) for a in small_args()], 2)
     assert "T0(carray(pointer(w[0], Dfloat64), (w[1], )), f[0])" in source     # the namedtuple
     assert "carray(pointer(w[2], Dfloat64), (w[3], ))" in source                # out
     assert "w[4], f[1], w[5] != 0)" in source                                    # int, float, bool
@@ -568,7 +599,7 @@ def engine_files():
     if machinecode.folder() is None:
         pytest.skip("no cache folder")
     from rtcli.rendering.warmup import _scenes, machine_code
-    machinecode._loaded.clear()
+    entries._loaded.clear()
     made, why = machine_code(choose(_scenes()[0], "compiled", notes=lambda text: None))
     assert made == [fast.ENTRY, compiled_build.LEVELS], why
     return made

@@ -21,8 +21,9 @@ import numpy as np
 import pytest
 
 from rtcli import compiled as fast
-from rtcli import machinecode, variants
+from rtcli import variants
 from rtcli.compiled import loading
+from rtcli.kernels.machinecode import entries, places
 from rtcli.rendering.engine import choose
 
 pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
@@ -155,7 +156,8 @@ def test_numba_writes_to_the_per_user_cache_when_the_sources_are_read_only(warm,
     user = tmp_path / "user-cache"
     cache = seeded(user / "rtcli" / "numba", TRACE_CAMERA)
     code = textwrap.dedent("""
-        from rtcli import machinecode, variants
+        from rtcli import variants
+        from rtcli.kernels import machinecode
         real = variants.writable
         variants.writable = lambda f: not f.startswith(variants.PACKAGE_DIR) and real(f)
         from rtcli.cli import main
@@ -273,8 +275,8 @@ def test_after_warmup_no_scene_compiles_anything(warm, monkeypatch):
               sorted((ROOT / "bench").glob("*.yaml"))]
     for scene in scenes:
         assert choose(scene, "compiled").entry is not None
-    monkeypatch.setattr(machinecode, "ENABLED", False)
-    monkeypatch.setattr(machinecode, "_loaded", {})
+    monkeypatch.setattr(places, "ENABLED", False)
+    monkeypatch.setattr(entries, "_loaded", {})
     for scene in scenes:
         for engine in ("numpy", "compiled") if fast.unsupported(scene) is None else ("numpy",):
             render(scene, Job(16, 12, engine=engine))

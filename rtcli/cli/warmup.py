@@ -22,7 +22,8 @@ def warmup(cluster, cluster_file, local_cluster):
         from rtcli.cluster.warm import warm  # start-up: Dask only when asked
         with where:
             return warm(where.session(), click.echo)
-    from rtcli import machinecode, variants  # start-up
+    from rtcli import variants  # start-up
+    from rtcli.kernels import machinecode
     from rtcli.rendering.warmup import bytecode
     from rtcli.rendering.warmup import warmup as warm
     start = time.perf_counter()

@@ -10,7 +10,7 @@ place, rtcli/rendering/engine.py, from what this package says: what it cannot re
 cached (starts_at_once, ready_to_load). It also gives the numpy engine its compiled BVH
 walks (walks.py) and tree build (build.py), through that place.
 
-The integrator starts from its machine code file (rtcli/machinecode.py) when there is
+The integrator starts from its machine code file (rtcli/kernels/machinecode) when there is
 one for this process, at once and without numba. Otherwise numba is imported,
 and the integrator compiled or loaded from numba's on-disk cache, only when a render
 takes this path; that writes the machine code file after a compile (and `rtcli warmup`
@@ -31,11 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rtcli import machinecode, variants
+from rtcli import variants
 from rtcli.compiled.loading import Load, cached, ready, say
 from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
+from rtcli.kernels import machinecode
 from rtcli.stats import Stats
 
 __all__ = ["Compiled", "Load", "ready_to_load", "starts_at_once", "unsupported", "why_not"]
@@ -45,7 +46,7 @@ class Compiled:
     """A scene packed for the compiled integrator; trace_pixels() stands in for camera rays + trace.
 
     Making one loads the integrator's machine code at once, from its machine code file
-    (rtcli/machinecode.py) or through numba (from numba's cache, or compiling it):
+    (rtcli/kernels/machinecode) or through numba (from numba's cache, or compiling it):
     worker processes forked afterwards inherit it."""
 
     def __init__(self, scene, bvh: bool = True, notes=None, start: float | None = None):
@@ -154,7 +155,7 @@ _cache_checked = False
 
 
 def why_not() -> str | None:
-    """Make the compiled integrator ready to load: its machine code file (rtcli/machinecode.py)
+    """Make the compiled integrator ready to load: its machine code file (rtcli/kernels/machinecode)
     when there is one for this process, else numba and the integrator imported; why not, if it
     cannot be. The cache is checked against the sources once a process (a batch, a watch or a
     cluster worker renders many jobs)."""

@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import sys
 
-from rtcli import machinecode, variants
+from rtcli import variants
 from rtcli.core.bvh_build import levels, levels_build
+from rtcli.kernels import machinecode
 
-LEVELS = "levels"                 # the machine code file of `levels` (rtcli/machinecode.py)
+LEVELS = "levels"                 # the machine code file of `levels` (rtcli/kernels/machinecode)
 
 
 def _compiled_levels():

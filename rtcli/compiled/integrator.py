@@ -229,6 +229,6 @@ def trace_camera(g, s, cam, x, y, nc, nr, counts, stack, out, frames):
     """The colors of the primary rays through the pixel coordinates (x, y) (n,) of a camera (its
     row: rtcli/core/camera.py) into out (n, 3). The caller gives the scratch: stack (the
     traversal's) and frames (pack.frames), so that this entry allocates nothing
-    and runs as machine code without numba (rtcli/machinecode.py)."""
+    and runs as machine code without numba (rtcli/kernels/machinecode)."""
     for i in range(len(x)):
         out[i] = radiance(g, s, primary_ray(cam, x[i], y[i], nc, nr), counts, frames, stack)

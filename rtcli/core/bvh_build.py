@@ -64,7 +64,7 @@ def scratch(lo, hi, bins: int) -> tuple:
     level in node order (work) with their boxes (p_lo, p_hi), the same three for the next level, the
     node sizes and bounds of this level and the next, and per node the bins' counts and boxes, the
     counts and areas right of each cut and the bins' scale per axis. The caller makes them, so that
-    `levels` allocates nothing (it runs as machine code without numba: rtcli/machinecode.py)."""
+    `levels` allocates nothing (it runs as machine code without numba: rtcli/kernels/machinecode)."""
     m = len(lo)
     return (np.arange(m), lo.copy(), hi.copy(), np.empty(m, dtype=np.int64), np.empty((m, 3)), np.empty((m, 3)),
             np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64), np.empty((m, 4, 3)), np.empty((m, 4, 3)),

@@ -15,7 +15,7 @@ from functools import partial
 
 import numpy as np
 
-from rtcli import machinecode, variants, wavefront
+from rtcli import variants, wavefront
 from rtcli.compiled import ENTRY, compiled_integrator
 from rtcli.compiled import build as compiled_build
 from rtcli.compiled.loading import Load
@@ -25,6 +25,7 @@ from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, SceneObject
 from rtcli.errors import RtcliError
+from rtcli.kernels import machinecode
 from rtcli.rendering.engine import choose
 from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.plane import Plane
@@ -63,7 +64,7 @@ def warmup(notes=None) -> tuple[list[tuple[str, Load]], tuple[list[str], str | N
 
 
 def machine_code(engine) -> tuple[list[str], str | None]:
-    """Write the machine code files (rtcli/machinecode.py) of the integrator and of the BVH build,
+    """Write the machine code files (rtcli/kernels/machinecode) of the integrator and of the BVH build,
     unless they are at hand and fit (`engine`: a Compiled, whose arguments the file takes): the
     entries that have a usable file afterwards, and why one could not be written (or None)."""
     why, found = None, machinecode.load(ENTRY)
