@@ -65,13 +65,12 @@ def cluster_options(doing: str = "Render on", extra: str = " --workers is then u
     return add
 
 
-def reach(address, file, local):
+def reach(address, file, local, notes):
     """The cluster the options name (a cluster.renders.Reach, to use in a `with` block), or None;
-    rtcli.cluster (and Dask) only when one is named. The workers' notes go to stderr above the
-    progress bar."""
+    rtcli.cluster (and Dask) only when one is named. The workers' notes go to `notes`
+    (terminal.note: stderr, above the progress bar)."""
     if not (address or file or local):
         return None
-    from rtcli.cli.terminal import note  # start-up: Dask only when asked
-    from rtcli.cluster.renders import Reach
+    from rtcli.cluster.renders import Reach  # start-up: Dask only when asked
     from rtcli.cluster.target import target
-    return Reach(target(address, file, local), note)
+    return Reach(target(address, file, local), notes)

@@ -145,7 +145,7 @@ def render(**options):
     check_engine(o.engine)
     if o.stats:                     # why a machine code file is not used, if one is not
         machinecode.report_to(terminal.note)
-    where = reach(o.cluster, o.cluster_file, o.local_cluster)
+    where = reach(o.cluster, o.cluster_file, o.local_cluster, terminal.note)
     lint = terminal.lint(o.quiet, o.strict, o.several, o.watch)
     with where or contextlib.nullcontext():
         if o.sequence and not o.several:

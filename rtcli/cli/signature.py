@@ -6,6 +6,7 @@ from __future__ import annotations
 import click
 
 from rtcli.cli.options import SIZE, check_outputs, check_size, cluster_options, load, not_empty, output_name, reach
+from rtcli.cli.terminal import note
 from rtcli.errors import one_line
 
 
@@ -34,7 +35,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     from rtcli.cli.render_stills import on_cluster
     from rtcli.core.display import signature_colors
     from rtcli.rendering.writer import write_images
-    where = reach(cluster, cluster_file, local_cluster)
+    where = reach(cluster, cluster_file, local_cluster, note)
     loaded, scene = load(scene_file, frame, keep=where is not None)
     out = output_name(scene_file, output, ".sig.png")
     check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), scene.inputs)

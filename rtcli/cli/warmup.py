@@ -9,6 +9,7 @@ import time
 import click
 
 from rtcli.cli.options import cluster_options, reach
+from rtcli.cli.terminal import note
 
 
 @click.command()
@@ -17,7 +18,7 @@ def warmup(cluster, cluster_file, local_cluster):
     """Compile the render engine now (about a minute, once), or load it from numba's cache; say
     where the cache is and how long it took. Renders then start at once. With a cluster option:
     on every worker of the cluster at once, a line for each."""
-    where = reach(cluster, cluster_file, local_cluster)
+    where = reach(cluster, cluster_file, local_cluster, note)
     if where is not None:
         from rtcli.cluster.warm import warm  # start-up: Dask only when asked
         with where:
