@@ -23,8 +23,10 @@ import threading
 from collections.abc import Callable
 
 from rtcli.errors import RtcliError, shown
+from rtcli.preview.against import Golden
 from rtcli.preview.options import Options
 from rtcli.preview.session import Session
+from rtcli.preview.tev import Tev
 
 __all__ = ["Options", "serve"]
 
@@ -44,10 +46,8 @@ def serve(scene: str, options: Options, *, host: str = "127.0.0.1", port: int = 
     if host != "127.0.0.1":
         say(f"warning: --host {shown(host)}: the preview is served beyond 127.0.0.1; whoever reaches it there "
             "and has the URL's token sees this scene's renders")
-    from rtcli.preview.against import Golden
     golden = Golden(against) if against is not None else None
     if tev is not None:
-        from rtcli.preview.tev import Tev
         tev = Tev(tev, say)
     try:
         asyncio.run(_serve(scene, options, host, port, browser, golden, tev, url, say))
@@ -57,7 +57,7 @@ def serve(scene: str, options: Options, *, host: str = "127.0.0.1", port: int = 
 
 
 async def _serve(scene, options, host, port, browser, golden, tev, url, say) -> None:
-    from aiohttp import web
+    from aiohttp import web  # the extra `preview`, checked on entry to serve
 
     from rtcli.preview.server import Preview, logging_to
     loop, token = asyncio.get_running_loop(), secrets.token_urlsafe(24)
@@ -87,7 +87,7 @@ async def _serve(scene, options, host, port, browser, golden, tev, url, say) -> 
 
 async def _listen(runner, host: str, port: int) -> int:
     """Listen on host:port (port 0: any free one); the port. A busy port is an RtcliError."""
-    from aiohttp import web
+    from aiohttp import web  # the extra `preview`
     site = web.TCPSite(runner, host, port)
     try:
         await site.start()
@@ -120,7 +120,7 @@ def _post(loop, publish, message) -> None:
 def _open(url: str, say: Callable[[str], None]) -> None:
     """Open the page in the user's browser ($BROWSER, else the system's), where there is a screen
     to show it: without one, Python would pick a text browser, which would take the terminal."""
-    import webbrowser
+    import webbrowser  # start-up: only when a browser is opened
     screen = sys.platform in ("darwin", "win32") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
     if not (os.environ.get("BROWSER") or screen) or not webbrowser.open(url):
         say("note: no browser to open here: open the URL above in one")

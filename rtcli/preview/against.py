@@ -6,6 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from rtcli.api.results import png_bytes
+from rtcli.compare.difference import diff
+from rtcli.compare.images import read_png
 from rtcli.errors import RtcliError, shown
 
 
@@ -21,8 +24,6 @@ class Golden:
     """The golden image, and the pictures of the last comparison with it (PNG bytes)."""
 
     def __init__(self, path: str):
-        from rtcli.api.results import png_bytes
-        from rtcli.compare.images import read_png
         self.path, self.pixels = path, read_png(path)
         if self.pixels.ndim != 3:
             raise RtcliError(f"{shown(path)}: an id map (16-bit gray); --against takes an RGB image")
@@ -37,8 +38,6 @@ class Golden:
     def compare(self, render: int, image: np.ndarray) -> dict:
         """Compare a finished render's picture with the golden image: the message for the pages;
         its heat map and FLIP map (for the same size) kept as pictures."""
-        from rtcli.api.results import png_bytes
-        from rtcli.compare.difference import diff
         same = image.shape == self.pixels.shape
         d = diff(image, self.pixels, flip=self.flip and same)
         pictures = {"golden": self.pictures["golden"]}

@@ -27,6 +27,7 @@ from importlib import resources
 from aiohttp import WSCloseCode, WSMsgType, web
 from aiohttp.http_exceptions import HttpProcessingError
 
+from rtcli.api.results import png_bytes
 from rtcli.errors import RtcliError, one_line
 from rtcli.preview.session import Busy, Session
 
@@ -251,7 +252,6 @@ class Preview:
 
     async def image(self, request: web.Request) -> web.Response:
         """The picture as it is now."""
-        from rtcli.api.results import png_bytes
         image = self.session.image
         if image is None:
             raise web.HTTPNotFound(text="404: nothing rendered yet\n")

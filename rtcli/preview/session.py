@@ -23,12 +23,20 @@ from collections.abc import Callable
 
 import numpy as np
 
+from rtcli.api import explain, signature, view
+from rtcli.api.loading import load_file, of_loaded
+from rtcli.api.results import RenderStats, png_bytes
 from rtcli.errors import RtcliError, error_line, one_line, plural, shown
+from rtcli.inspect.checks import object_rows
+from rtcli.inspect.lint import lines
 from rtcli.inspect.views import KINDS as VIEWS
+from rtcli.inspect.views import picture, summary
 from rtcli.preview import messages
 from rtcli.preview.options import Options
 from rtcli.preview.passes import Progressive, passes
+from rtcli.rendering.tiles import Job
 from rtcli.rendering.watch import Changes, recording
+from rtcli.scenefile.reuse import Kept
 
 POLL = 0.05                        # seconds between looks at the scene's files
 MAX_IDS = 65535                    # objects a signature's 16-bit ids tell apart (api.check_ids)
@@ -93,7 +101,6 @@ class Session:
     # --- the thread ---
 
     def run(self) -> None:
-        from rtcli.scenefile.reuse import Kept
         self._kept = Kept()
         while not self._stopping.is_set():
             try:
@@ -109,8 +116,6 @@ class Session:
 
     def _load(self) -> None:
         """Load the scene file, recording what it reads; publish the error of a broken one."""
-        from rtcli.api.loading import load_file, of_loaded
-        from rtcli.inspect.lint import lines
         self._reload = False
         o = self.options
         with recording(self.path, self._kept) as seen:
@@ -145,7 +150,6 @@ class Session:
     def _render(self) -> None:
         """Render the scene in hand pass by pass; return early when a file changes, another frame
         is asked for, or the preview stops."""
-        from rtcli.rendering.tiles import Job
         self._rerender, o, scene = False, self.options, self.scene
         self.render += 1
         self.views, self.done, self.compare, self.progress = {}, None, None, None
@@ -190,7 +194,6 @@ class Session:
 
     def _signature(self) -> None:
         """The id map of the scene in hand (hover and outline on the page), when its ids fit in 16 bits."""
-        from rtcli.api import signature
         if len(self.scene.model.objects) > MAX_IDS:
             return
         self.ids = np.asarray(signature(self.scene, workers=1))
@@ -198,7 +201,6 @@ class Session:
 
     def _finish(self, run: Progressive) -> None:
         """The render is done: its stats, the golden comparison, tev's channels."""
-        from rtcli.api.results import RenderStats
         s, scene = run.stats, self.scene
         stats = RenderStats.of(scene.width, scene.height, scene.model.settings.samples, s, run.progress.seconds,
                                start_up=False)
@@ -220,7 +222,6 @@ class Session:
         return name if self.base.frames == 1 else f"{name} frame {self.frame}"
 
     def _scene_info(self, scene) -> dict:
-        from rtcli.inspect.checks import object_rows
         return {"type": "scene", "render": self.render, "name": shown(self.path), "title": self._title(),
                 "width": scene.width, "height": scene.height, "frame": self.frame, "frames": self.base.frames,
                 "samples": scene.model.settings.samples, "warnings": self.warnings,
@@ -259,7 +260,6 @@ class Session:
     def _explain(self, x: int, y: int) -> tuple[str, str]:
         """Pixel (x, y) of the frame shown explained: `rtcli explain --json`'s text, and its tree as
         `rtcli explain` prints it (rtcli/inspect/explain.py)."""
-        from rtcli.api import explain
         if self.scene is None:
             raise RtcliError("the scene has not loaded: nothing to explain")
         e = explain(self.scene, x, y, gamma=self.options.gamma, bvh=self.options.bvh)
@@ -267,9 +267,6 @@ class Session:
 
     def _view(self, kind: str) -> tuple[np.ndarray, str, bytes]:
         """(data, summary, PNG) of the debug view `kind` of the frame shown (rtcli/inspect/views.py)."""
-        from rtcli.api import view
-        from rtcli.api.results import png_bytes
-        from rtcli.inspect.views import picture, summary
         if self.scene is None:
             raise RtcliError("the scene has not loaded: no view to show")
         if kind not in VIEWS:

@@ -42,7 +42,7 @@ class Tev:
 
     def __init__(self, where: str, say: Callable[[str], None]):
         try:
-            import tevclient
+            import tevclient  # the extra `preview`, for --tev only
         except ImportError:
             raise RtcliError("--tev needs the tevclient package (Python 3.11 or later): pip install -e "
                              "'.[preview]' in the rtcli folder") from None
