@@ -17,6 +17,11 @@ import io
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from PIL import Image
+
+from rtcli.core.display import signature_colors, to_8bit
+from rtcli.rendering.outputs import check_outputs
+from rtcli.rendering.writer import write_png
 
 
 @dataclass(frozen=True)
@@ -101,7 +106,6 @@ class ImageArray(np.ndarray):
         """The 8-bit image: linear colors clamped to [0, 1], optionally sRGB-encoded, rounded; an id
         map as its signature picture (a fixed color per id, as `rtcli signature` draws it); a
         debug view as its picture."""
-        from rtcli.core.display import signature_colors, to_8bit
         if self.picture is not None:
             return ImageArray(self.picture, inputs=self.inputs)
         if self.is_ids:
@@ -114,15 +118,12 @@ class ImageArray(np.ndarray):
 
     def to_pil(self):
         """A Pillow image: RGB for colors (linear ones converted by to_8bit()), 16-bit gray for ids."""
-        from PIL import Image
         return Image.fromarray(np.asarray(self if self.is_ids else self.to_8bit()))
 
     def save(self, path: str) -> None:
         """Write the image as `rtcli render` (or an id map as `rtcli signature --ids`) would: the format
         follows the extension, the file is replaced atomically, and an input of the scene, a
         folder or a device is refused (RtcliError)."""
-        from rtcli.rendering.outputs import check_outputs
-        from rtcli.rendering.writer import write_png
         path = str(path)
         check_outputs([(path, self.is_ids)], list(self.inputs))
         write_png(path, np.asarray(self if self.is_ids else self.to_8bit()))
@@ -138,7 +139,6 @@ class ImageArray(np.ndarray):
 
 def png_bytes(pixels: np.ndarray) -> bytes:
     """An 8-bit image encoded as PNG, in memory."""
-    from PIL import Image
     buffer = io.BytesIO()
     Image.fromarray(pixels).save(buffer, format="PNG")
     return buffer.getvalue()

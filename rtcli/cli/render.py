@@ -136,9 +136,9 @@ def refused(o: Options) -> str | None:
 def render(**options):
     """Render SCENE.yaml to an image (see docs/scene-format.md for the scene format), or its frames;
     several scenes, or a folder of them, to a folder of images."""
-    from rtcli.api.options import check_engine
+    from rtcli.api.options import check_engine  # start-up: the library, once the options parse
     from rtcli.cli import render_frames, render_stills, terminal
-    from rtcli.kernels import machinecode  # start-up
+    from rtcli.kernels import machinecode
     o = Options(**options)
     if (why := refused(o)) is not None:
         raise click.UsageError(why)

@@ -22,6 +22,8 @@ import numpy as np
 from rtcli.core.scene import Scene
 from rtcli.errors import RtcliError, one_line, plural, shown
 from rtcli.scenefile.remarks import Remark, Remarks
+from rtcli.wavefront.intersect import find_first_hit, nearest_over, no_hits
+from rtcli.wavefront.rays import camera_rays
 
 SMALL = 64                         # the camera check's signature is SMALL pixels on its long side,
 LARGER = 512                       # then LARGER when that sees nothing (a small object can hide between rays)
@@ -151,8 +153,6 @@ def _wholly_in_view(scene: Scene, cam) -> bool:
 def _signature_hits(scene: Scene, size: int, objects=None) -> bool:
     """Whether a primary ray through a pixel centre of the image scaled to `size` pixels on its
     long side (never enlarged) hits an object (of `objects` when given, else any)."""
-    from rtcli.wavefront.intersect import find_first_hit, nearest_over, no_hits
-    from rtcli.wavefront.rays import camera_rays
     s = scene.settings
     scale = min(1.0, size / max(s.width, s.height))
     w, h = max(1, round(s.width * scale)), max(1, round(s.height * scale))
