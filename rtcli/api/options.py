@@ -3,7 +3,7 @@ and the image size (width or height alone keeping the scene's aspect ratio)."""
 
 from __future__ import annotations
 
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.errors import RtcliError
 from rtcli.scenefile.build import camera_form, check_image_size
 

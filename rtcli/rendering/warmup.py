@@ -15,7 +15,8 @@ from functools import partial
 
 import numpy as np
 
-from rtcli import variants, wavefront
+from rtcli import wavefront
+from rtcli.kernels import numba_cache, variants
 from rtcli.compiled import ENTRY, compiled_integrator
 from rtcli.compiled import build as compiled_build
 from rtcli.compiled.loading import Load
@@ -87,4 +88,4 @@ def bytecode() -> bool:
     so that no run compiles them again (a run that may not write bytecode, PYTHONDONTWRITEBYTECODE,
     would every time); whether that worked."""
     import compileall
-    return bool(compileall.compile_dir(variants.PACKAGE_DIR, quiet=2))
+    return bool(compileall.compile_dir(numba_cache.PACKAGE_DIR, quiet=2))
