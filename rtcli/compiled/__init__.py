@@ -31,12 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rtcli.kernels import numba_cache, variants
+from rtcli.compiled.integrator import trace_camera
 from rtcli.compiled.loading import Load, cached, ready, say
 from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
-from rtcli.kernels import machinecode
+from rtcli.kernels import machinecode, numba_cache, variants
 from rtcli.stats import Stats
 
 __all__ = ["Compiled", "Load", "ready_to_load", "starts_at_once", "unsupported", "why_not"]
@@ -99,7 +99,6 @@ ENTRY = "trace_camera"
 
 
 def compiled_integrator():
-    from rtcli.compiled.integrator import trace_camera
     return variants.compiled(trace_camera)
 
 

@@ -51,8 +51,8 @@ import functools
 import hashlib
 import importlib.util
 import math
-import sys
 import os
+import sys
 import types
 
 import numpy as np
@@ -161,7 +161,7 @@ def _suffix(bind: dict) -> str:
 
 def _numba(f, how: Kernel):
     _start_numba()
-    from numba import njit
+    from numba import njit  # numba, optional (the fast extra): only when compiling
     where = cache_location()
     options = dict(cache=where.enabled, error_model="numpy")
     if not how.entry:

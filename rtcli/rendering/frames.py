@@ -18,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from PIL import Image, UnidentifiedImageError
 
 from rtcli.errors import RtcliError, shown
 from rtcli.rendering.movie import check_size, is_movie, movie_format, write_movie
@@ -112,7 +113,6 @@ def to_render(seq: Sequence, skip_existing: bool, job) -> list[int]:
 def has_image(path: str, width: int, height: int) -> bool:
     """Whether `path` is a regular file holding an image of width x height (only its header is read):
     what --skip-existing keeps."""
-    from PIL import Image, UnidentifiedImageError
     if not os.path.isfile(path):
         return False
     try:
@@ -158,7 +158,6 @@ def local_frames(loaded, todo: list[int], job, workers: int, changes: dict, prog
 
 def _read_back(path: str, job) -> np.ndarray:
     """A frame written by an earlier run, for a movie."""
-    from PIL import Image, UnidentifiedImageError
     try:
         with Image.open(path) as img:
             pixels = np.asarray(img.convert("RGB"))

@@ -13,6 +13,7 @@ import os
 import stat
 
 from rtcli.errors import RtcliError, shown
+from rtcli.rendering.movie import movie_format
 from rtcli.rendering.writer import image_format
 from rtcli.scenefile.files import kind_of
 
@@ -27,7 +28,6 @@ def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> N
         real = os.path.realpath(path)
         _check_file(path, reals, known)
         if ids == "movie":
-            from rtcli.rendering.movie import movie_format
             movie_format(path)
         else:
             image_format(path, ids)
