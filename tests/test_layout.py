@@ -136,7 +136,7 @@ def test_a_long_function_is_found(tmp_path):
 
 def unexplained_imports(path: Path) -> list[int]:
     """The lines of imports inside functions with no comment saying why they wait: a run of imports
-    one after another needs one comment among them."""
+    one after another needs one comment among them or on the line above."""
     text = path.read_text()
     lines, found = text.splitlines(), []
     for function in ast.walk(ast.parse(text)):
@@ -148,7 +148,8 @@ def unexplained_imports(path: Path) -> list[int]:
                 if isinstance(statement, (ast.Import, ast.ImportFrom)):
                     run.append(statement)
                     continue
-                if run and not any("#" in line for line in lines[run[0].lineno - 1:run[-1].end_lineno]):
+                if run and not any(line.lstrip().startswith("#") or "  #" in line
+                                   for line in lines[run[0].lineno - 2:run[-1].end_lineno]):
                     found.append(run[0].lineno)
                 run = []
     return sorted(set(found))
@@ -163,5 +164,6 @@ def test_imports_inside_functions_say_why_they_wait():
 def test_an_unexplained_import_is_found(tmp_path):
     source = tmp_path / "m.py"
     source.write_text("def f():\n    import json\n    import csv\n\n\ndef g():\n"
-                      "    import json  # start-up\n    import csv\n    if x:\n        import zlib\n")
-    assert unexplained_imports(source) == [2, 10]
+                      "    import json  # start-up\n    import csv\n    if x:\n        import zlib\n"
+                      "    # start-up\n    import zlib\n    x = '#'\n    import csv\n")
+    assert unexplained_imports(source) == [2, 10, 14]

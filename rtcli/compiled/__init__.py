@@ -31,7 +31,6 @@ from pathlib import Path
 
 import numpy as np
 
-from rtcli.compiled.integrator import trace_camera
 from rtcli.compiled.loading import Load, cached, ready, say
 from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
@@ -99,6 +98,9 @@ ENTRY = "trace_camera"
 
 
 def compiled_integrator():
+    # start-up: the integrator's module compiles its dispatch with numba when imported, which a
+    # render from the machine code files never loads
+    from rtcli.compiled.integrator import trace_camera
     return variants.compiled(trace_camera)
 
 
