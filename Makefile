@@ -35,7 +35,7 @@ test-all: warmup
 	$(PY) -m pytest -q
 
 golden: $(FULL)
-	$(PY) -m pytest -q tests/test_golden.py --update-goldens
+	$(PY) -m pytest -q tests/renders/test_golden.py --update-goldens
 
 bench: warmup
 	-$(PY) -m pip install --quiet -e '.[bench]' || echo "the bench extra (mitsuba, embreex) did not install: timing without them"

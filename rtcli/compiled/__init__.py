@@ -3,7 +3,7 @@
 numpy's throughput on arrays bounds the wavefront engine (rtcli/wavefront/) at
 about 1.4 ns per element-operation, with dozens of operations per ray and bounce.
 This package runs the same integrator one ray at a time, compiled, on the same
-kernels (rtcli/kernels/variants.py), and gives the same pixels (tests/test_compiled.py
+kernels (rtcli/kernels/variants.py), and gives the same pixels (tests/compiled/test_compiled.py
 renders every supported scene both ways). Which engine renders a job is decided in one
 place, rtcli/rendering/engine.py, from what this package says: what it cannot render
 (pack.unsupported), why it cannot start (why_not), whether it starts at once or its code is

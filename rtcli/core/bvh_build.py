@@ -8,7 +8,7 @@ by count. A split keeps the primitives' order on each side. Nodes are numbered l
 by level, a node's two children side by side, and the leaves' primitives are laid
 out level by level in `perm` (the layout of core/bvh.py).
 
-Two builds make the same tree, number for number (tests/test_bvh.py):
+Two builds make the same tree, number for number (tests/core/test_bvh.py):
 - `numpy_build` (rtcli/core/bvh_build_numpy.py): all nodes of a level at once, no
   per-primitive Python loop.
 - `levels`, per node and per primitive (python and compiled variants, rtcli/kernels/variants.py):

@@ -3,7 +3,7 @@
 The compiled engine calls one entry point, the integrator (trace_camera); the numpy engine
 calls two compiled walks, over a mesh's triangles and over a BVH of spheres. Each is called
 here once, through the engines' own code on two small scenes made in code, so with the same
-argument types as in any render: afterwards no render compiles (tests/test_startup.py renders
+argument types as in any render: afterwards no render compiles (tests/compiled/test_startup.py renders
 every scene and checks that). A second warmup loads the code from the cache in well under a
 second and says that nothing was compiled.
 """
