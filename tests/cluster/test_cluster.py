@@ -39,6 +39,8 @@ from rtcli.kernels import numba_cache, variants
 from rtcli.rendering import frames
 from rtcli.rendering.tiles import Job, render
 
+pytestmark = pytest.mark.slow   # Dask schedulers and worker processes
+
 distributed = pytest.importorskip("distributed")
 
 SCENE = """\

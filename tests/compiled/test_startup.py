@@ -27,7 +27,8 @@ from rtcli.kernels import numba_cache, variants
 from rtcli.kernels.machinecode import entries, places
 from rtcli.rendering.engine import choose
 
-pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
+pytestmark = [pytest.mark.slow,   # processes of their own, and numba caches seeded to compile in
+              pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")]
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -22,7 +22,8 @@ from rtcli.kernels import machinecode, variants
 from rtcli.kernels.machinecode import entries, places, writing
 from rtcli.rendering.engine import choose
 
-pytestmark = pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
+pytestmark = [pytest.mark.slow,   # machine code files written and planted, processes of their own
+              pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")]
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "scenes" / "whitted.yaml"

@@ -561,6 +561,7 @@ def test_helper_calls_are_found_on_the_paths_that_raise_nothing(change, found):
     assert flow.helper_calls(MODULE.format(**{**RAISING, **change}), "root") == found
 
 
+@pytest.mark.slow                   # the engine's files, made if missing
 def test_the_engines_modules_call_numbas_helpers_only_where_they_raise(engine_files):
     """The integrator's and the BVH build's modules (made by numba now, as make does) reach numba's
     helpers and Python's only on paths that raise, and do reference them there."""
@@ -607,6 +608,7 @@ def engine_files():
 SCENES = ["whitted", "csg", "bubble", "textures", "teapot", "inspect"]
 
 
+@pytest.mark.slow                   # the engine's files, made if missing
 @pytest.mark.parametrize("name", SCENES)
 def test_the_integrators_file_gives_numbas_pixels(engine_files, name):
     scene = load_scene(str(ROOT / "scenes" / f"{name}.yaml"))
@@ -621,6 +623,7 @@ def test_the_integrators_file_gives_numbas_pixels(engine_files, name):
     assert from_file.std() > 0.01                        # a picture, not a blank
 
 
+@pytest.mark.slow                   # the engine's files, made if missing
 def test_the_bvh_builds_file_builds_the_reference_tree(engine_files):
     from bvh_reference import build as reference_build
     lo = np.random.default_rng(5).normal(size=(3000, 3))
@@ -632,6 +635,7 @@ def test_the_bvh_builds_file_builds_the_reference_tree(engine_files):
         assert np.array_equal(got, want)
 
 
+@pytest.mark.slow                   # the engine's files, made if missing
 def test_a_render_with_the_files_does_not_load_numba(engine_files, tmp_path):
     code = ("import sys, rtcli; img = rtcli.render(sys.argv[1], width=48, height=36); "
             "print(img.stats.engine, 'numba' in sys.modules)")
@@ -642,6 +646,7 @@ def test_a_render_with_the_files_does_not_load_numba(engine_files, tmp_path):
         assert done.stdout.split() == ["compiled", "False"], (scene, done.stdout, done.stderr)
 
 
+@pytest.mark.slow                   # the engine's files, made if missing
 def test_stale_sources_drop_the_files(engine_files, tmp_path):
     """drop_stale_cache deletes the files with numba's, in a copy of the cache whose sources
     fingerprint no longer matches."""

@@ -28,6 +28,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
+pytestmark = pytest.mark.slow   # every command of the README, at small sizes, in a copy of the clone
+
 ROOT = Path(__file__).resolve().parents[2]
 README = (ROOT / "README.md").read_text()
 COPIED = ["scenes", "golden_images", "README.md", ".gitignore", "Makefile", "pyproject.toml"]
