@@ -65,23 +65,23 @@ def layer_channels(kind: str, data: np.ndarray, dtype) -> dict[str, np.ndarray]:
     return {name: np.ascontiguousarray(planes[..., k], dtype=dtype) for k, name in enumerate(names)}
 
 
-def read_exr(path: str, max_pixels: int, header_only: bool = False) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+def read_exr(path: str, max_pixels: int, header_only: bool = False) -> tuple[dict[str, np.ndarray], dict]:
     """An EXR's channels (name -> (H, W) array: float32, float16 or uint32) and its rtcli header
     attributes; RtcliError naming the file when it is not a readable EXR or has more than
-    max_pixels. With header_only, no channel is read."""
+    max_pixels. With header_only, no channel is read, and the second is the whole header."""
     exr = openexr()
     try:
         with exr.File(path, header_only=True) as head:
-            header = head.header()
+            header = dict(head.header())                 # the file's closing empties its header
         (x0, y0), (x1, y1) = header["dataWindow"]
         if (x1 - x0 + 1) * (y1 - y0 + 1) > max_pixels:
             raise RtcliError(f"{shown(path)}: {x1 - x0 + 1}x{y1 - y0 + 1} is more than the {max_pixels:,} pixels "
                              "rtcli reads")
-        meta = provenance.ours(header.items())
         if header_only:
-            return {}, meta
+            return {}, header
+        meta = provenance.ours(header.items())
         with exr.File(path, separate_channels=True) as image:
-            return {name: np.asarray(c.pixels) for name, c in image.channels().items()}, meta
+            return {name: np.array(c.pixels) for name, c in image.channels().items()}, meta
     except RtcliError:
         raise
     except Exception as error:                # the package raises plain exceptions for bad files
