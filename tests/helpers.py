@@ -68,3 +68,24 @@ def without_avx512(args: list[str], **kwargs) -> subprocess.CompletedProcess:
     done = subprocess.run([sys.executable, *args], env=env, capture_output=True, text=True, timeout=600, **kwargs)
     assert done.returncode == 0, done.stderr
     return done
+
+
+def image_summary(path, ignore=()) -> tuple:
+    """An image file's decoded pixels (mode, size, bytes) and its provenance without the render's
+    time and the keys in `ignore`: what two renders of one scene with the same settings agree on.
+    Their files differ by the time rtcli writes into them, so tests compare these, not bytes."""
+    from PIL import Image
+
+    from rtcli.rendering.reading import picture_meta
+    with Image.open(path) as img:
+        img.load()
+        meta = picture_meta(img)
+        summary = (img.mode, img.size, img.tobytes())
+    assert meta, f"{path}: no provenance"
+    dropped = {"rtcli.render_seconds", *(f"rtcli.{k}" for k in ignore)}
+    return summary, {k: v for k, v in meta.items() if k not in dropped}
+
+
+def same_image(a, b, ignore=()) -> bool:
+    """Whether two image files hold the same pixels and provenance (image_summary)."""
+    return image_summary(a, ignore) == image_summary(b, ignore)
