@@ -61,6 +61,7 @@ def _two_images(actual, expected, diff, flip_out, ids_mode, image_options: dict,
     from rtcli.rendering.provenance import differences
     from rtcli.rendering.writer import write_images
     a, e = floats.read_image(actual), floats.read_image(expected)
+    notes = differences(a.meta, e.meta)
     if ids_mode and (a.ids is not None or e.ids is not None):
         a, e = (a.ids if a.ids is not None else a), (e.ids if e.ids is not None else e)      # EXRs' id layers
     if ids_mode:
@@ -82,7 +83,7 @@ def _two_images(actual, expected, diff, flip_out, ids_mode, image_options: dict,
         summary += f", mean FLIP {mean:.4f}"
     write_images(pictures)
     click.echo(summary)
-    for note in differences(getattr(a, "meta", {}), getattr(e, "meta", {})):
+    for note in notes:
         click.echo(note)
     if not result.ok:
         raise click.exceptions.Exit(1)
