@@ -108,7 +108,7 @@ class ImageArray(np.ndarray):
 
     def __array_finalize__(self, obj) -> None:
         self.stats, self.inputs, self.picture = None, getattr(obj, "inputs", ()), None
-        self.meta, self.layers = dict(getattr(obj, "meta", None) or {}), {}
+        self.meta, self.layers = {}, {}                  # an array derived from an image is not that image
 
     @property
     def is_ids(self) -> bool:
