@@ -80,7 +80,11 @@ def image_summary(path, ignore=()) -> tuple:
     with Image.open(path) as img:
         img.load()
         meta = picture_meta(img)
-        summary = (img.mode, img.size, img.tobytes())
+        frames = []
+        for k in range(getattr(img, "n_frames", 1)):             # every frame of a movie
+            img.seek(k)
+            frames.append(img.convert("RGB").tobytes() if k else img.tobytes())
+        summary = (img.mode, img.size, frames)
     assert meta, f"{path}: no provenance"
     dropped = {"rtcli.render_seconds", *(f"rtcli.{k}" for k in ignore)}
     return summary, {k: v for k, v in meta.items() if k not in dropped}

@@ -166,3 +166,13 @@ def test_folders_of_exr_images_are_compared_and_the_report_shows_the_notes(run, 
     page = (tmp_path / "report" / "index.html").read_text()
     assert '<div class="note">note: made with different settings: samples 1 (actual) vs 2</div>' in page
     assert Image.open(tmp_path / "report" / "images" / "0001-actual.png").size == (20, 16)
+
+
+@pytest.mark.parametrize("name", ["m.apng", "m.gif"])
+def test_frames_and_movies_carry_it_too(run, tmp_path, name):
+    (tmp_path / "anim.yaml").write_text(SCENE.replace("image:", "animation: {frames: 3, fps: 12}\nimage:")
+                                        .replace("eye: [0, 0, 5]", "eye: {keys: {0: [0, 0, 5], 0.2: [0, 1, 5]}}"))
+    assert run("render", "anim.yaml", "-o", "f_%d.png", "--movie", name).exit_code == 0
+    assert Image.open(tmp_path / "f_2.png").text["rtcli.frame"] == "2"
+    result = run("info", name)
+    assert result.exit_code == 0 and "frame           1-3" in result.output.splitlines()

@@ -136,23 +136,27 @@ def render_sequence(loaded, seq: Sequence, job, skip_existing: bool, frames: Cal
         if k != loaded.frame:
             loaded.animation.scene(k)                          # every frame checked before any is rendered
     movie = {k: _read_back(seq.paths[k], job) for k in seq.frames if k not in todo and seq.movies}
-    stats, start = Stats(), time.perf_counter()
+    stats, start, total = Stats(), time.perf_counter(), 0.0
     for k, image, s in frames(todo) if todo else ():
+        seconds = time.perf_counter() - start
+        total += seconds
         if k in seq.paths:
-            write_png(seq.paths[k], image, frame_meta(loaded, job, k, s.engine, time.perf_counter() - start))
+            write_png(seq.paths[k], image, frame_meta(loaded, job, k, s.engine, seconds))
         if seq.movies:
             movie[k] = image
         stats.add(s)
         stats.engine = s.engine
         start = time.perf_counter()
+    frame_range = f"{seq.frames[0]}-{seq.frames[-1]}" if seq.frames else "-"
     for path in seq.movies:
-        write_movie(path, [movie[k] for k in seq.frames], loaded.animation.clock.fps)
+        write_movie(path, [movie[k] for k in seq.frames], loaded.animation.clock.fps,
+                    frame_meta(loaded, job, frame_range, stats.engine, total))
     return stats
 
 
-def frame_meta(loaded, job, frame: int, engine: str, seconds: float) -> dict[str, str]:
-    """The provenance of frame `frame`'s image (rendering/provenance.py); `seconds` from the end of
-    the frame before (or the start) to this one's."""
+def frame_meta(loaded, job, frame, engine: str, seconds: float) -> dict[str, str]:
+    """The provenance of frame `frame`'s image (rendering/provenance.py), or of a movie's ("FIRST-LAST");
+    `seconds` from the end of the frame before (or the start) to this one's, or of the frames rendered."""
     s = loaded.scene.settings
     return provenance(loaded.path, job.width, job.height, samples=s.samples, max_depth=s.max_depth, frame=frame,
                       block_size=job.block_size, gamma=job.gamma, engine=engine or "none", seconds=seconds)

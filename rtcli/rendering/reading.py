@@ -97,10 +97,12 @@ def _mode(img, path: str) -> str:
 
 
 def picture_meta(img) -> dict[str, str]:
-    """The provenance of an image Pillow opened: PNG text chunks, or the JSON of the TIFF's, JPEG's
-    or WebP's image description; {} when it has none."""
+    """The provenance of an image Pillow opened: PNG (and APNG) text chunks, or the JSON of the TIFF's,
+    JPEG's or WebP's image description or of a GIF's comment; {} when it has none."""
     if img.format == "PNG":
         return provenance.ours(getattr(img, "text", {}).items())
     if img.format == "TIFF":
         return provenance.from_json(img.tag_v2.get(provenance.DESCRIPTION))
+    if img.format == "GIF":
+        return provenance.from_json(img.info.get("comment"))
     return provenance.from_json(img.getexif().get(provenance.DESCRIPTION))
