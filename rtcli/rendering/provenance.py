@@ -4,7 +4,8 @@ A provenance is a dict of strings under the keys of KEYS: rtcli's version and th
 of its sources, the scene file's path and SHA-256, the frame, size, samples, max depth,
 block size, gamma, alpha, what the image holds (the color, a view, ids), the engine and
 the render's time. The writer stores it as PNG text chunks, EXR header attributes, or JSON
-in the TIFF, JPEG and WebP image description (BMP, PPM and PFM have no place for it);
+in the TIFF, JPEG and WebP image description, and movie.py as an APNG's text chunks or a
+GIF's comment (BMP, PPM and PFM have no place for it);
 read() gets it back from any of them, and differences() says what two images' differ in,
 for `rtcli compare`. The time and the engine never make a difference: the engines give the
 same pixels, and no two renders take the same time.
