@@ -176,3 +176,19 @@ def test_frames_and_movies_carry_it_too(run, tmp_path, name):
     assert Image.open(tmp_path / "f_2.png").text["rtcli.frame"] == "2"
     result = run("info", name)
     assert result.exit_code == 0 and "frame           1-3" in result.output.splitlines()
+
+
+def test_broken_float_files_are_one_line_errors(run, tmp_path):
+    assert run("render", "s.yaml", "-o", "a.pfm").exit_code == 0
+    (tmp_path / "bad.exr").write_bytes(b"v/1\x01" + b"\0" * 40)
+    (tmp_path / "cut.pfm").write_bytes((tmp_path / "a.pfm").read_bytes()[:-7])
+    (tmp_path / "huge.pfm").write_bytes(b"PF\n100000 100000\n-1.0\n" + b"\0" * 64)
+    (tmp_path / "text.pfm").write_bytes(b"P6\n2 2\n255\n" + b"\0" * 12)
+    for args, message in [(["bad.exr", "bad.exr"], "bad.exr: not a readable EXR"),
+                          (["cut.pfm", "a.pfm"], "cut.pfm: a PFM of 20x16 should hold 3,840 bytes of pixels, not 3,833"),
+                          (["huge.pfm", "a.pfm"], "huge.pfm: 100000x100000 is 10,000,000,000 pixels, more than"),
+                          (["text.pfm", "a.pfm"], "text.pfm: not a PFM file")]:
+        result = run("compare", *args)
+        assert result.exit_code == 2 and result.output.startswith(f"error: {message}"), result.output
+        assert result.output.count("\n") == 1
+    assert run("info", "bad.exr").output.startswith("error: bad.exr: not a readable EXR")
