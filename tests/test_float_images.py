@@ -16,6 +16,7 @@ from PIL import Image
 import rtcli
 from rtcli.cli import main
 from rtcli.core.display import to_8bit, to_16bit
+from rtcli.kernels import variants
 
 SCENE = """\
 image: {width: 24, height: 18}
@@ -122,7 +123,6 @@ def test_alpha_makes_the_background_transparent_in_png_and_exr(run, tmp_path):
 
 
 def test_alpha_is_the_same_with_the_compiled_engine():
-    from rtcli import variants
     if not variants.ENABLED:
         pytest.skip("numba is not installed")
     scene = SCENE.replace("image:", "render: {alpha: true, samples: 2}\nimage:")

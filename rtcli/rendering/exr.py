@@ -28,7 +28,7 @@ def openexr():
     """The OpenEXR package, or the error that says how to install it. Imported when an EXR is
     written or read: it is an optional extra, and most commands never need it."""
     try:
-        import OpenEXR
+        import OpenEXR  # an optional extra (exr), needed only by EXR files
     except ImportError:
         raise RtcliError("EXR files need the OpenEXR package: pip install -e '.[exr]' in the rtcli folder") \
             from None
