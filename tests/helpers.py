@@ -108,3 +108,27 @@ def seeded(root: Path, *without: str) -> Path:
         for f in found:
             f.unlink()
     return root
+
+def image_summary(path, ignore=()) -> tuple:
+    """An image file's decoded pixels (mode, size, bytes) and its provenance without the render's
+    time and the keys in `ignore`: what two renders of one scene with the same settings agree on.
+    Their files differ by the time rtcli writes into them, so tests compare these, not bytes."""
+    from PIL import Image
+
+    from rtcli.rendering.reading import picture_meta
+    with Image.open(path) as img:
+        img.load()
+        meta = picture_meta(img)
+        frames = []
+        for k in range(getattr(img, "n_frames", 1)):             # every frame of a movie
+            img.seek(k)
+            frames.append(img.convert("RGB").tobytes() if k else img.tobytes())
+        summary = (img.mode, img.size, frames)
+    assert meta, f"{path}: no provenance"
+    dropped = {"rtcli.render_seconds", *(f"rtcli.{k}" for k in ignore)}
+    return summary, {k: v for k, v in meta.items() if k not in dropped}
+
+
+def same_image(a, b, ignore=()) -> bool:
+    """Whether two image files hold the same pixels and provenance (image_summary)."""
+    return image_summary(a, ignore) == image_summary(b, ignore)

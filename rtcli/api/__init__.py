@@ -57,10 +57,12 @@ def _scene_of(scene: Scene | Source, frame: int | None) -> Scene:
 def render(scene: Scene | Source, *, width: int | None = None, height: int | None = None, samples: int | None = None,
            max_depth: int | None = None, engine: str = "auto", workers: int | None = None,
            block_size: int = 1, tile: int = TILE, gamma: bool = False, bvh: bool = True,
-           linear: bool = False, output: str | os.PathLike | None = None, progress: Progress | None = None,
+           linear: bool = False, alpha: bool | None = None, layers=(), bit_depth: int = 8, half: bool = False,
+           output: str | os.PathLike | None = None, progress: Progress | None = None,
            notes: Callable[[str], None] | None = None, frame: int | None = None) -> ImageArray:
     """Render a Scene (or what load_scene takes) to an ImageArray: uint8 (H, W, 3), or with
-    linear=True the float64 linear colors, unclamped.
+    linear=True the float64 linear colors, unclamped. alpha, layers, bit_depth and half: see
+    Scene.render (rtcli/api/pictures.py, render_scene) and docs/python-api.md.
 
     The options are the command line's: size (width or height alone keeps the aspect ratio),
     samples (n x n per pixel), max_depth, engine (auto, numpy or compiled), workers (processes;
@@ -75,7 +77,8 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
     check_options(frame=frame)
     return render_scene(_scene_of(scene, frame), width=width, height=height, samples=samples, max_depth=max_depth,
                         engine=engine, workers=workers, block_size=block_size, tile=tile, gamma=gamma, bvh=bvh,
-                        linear=linear, output=output, progress=progress, notes=notes)
+                        linear=linear, alpha=alpha, layers=layers, bit_depth=bit_depth, half=half, output=output,
+                        progress=progress, notes=notes)
 
 
 def signature(scene: Scene | Source, *, width: int | None = None, height: int | None = None, block_size: int = 1,

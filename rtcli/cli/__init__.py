@@ -1,4 +1,4 @@
-"""The rtcli command line (README.md, Commands): render, signature, explain, compare, validate,
+"""The rtcli command line (README.md, Commands): render, signature, explain, compare, info, validate,
 preview, presets, warmup; one module a command, this one the group that wires them.
 
 Argument handling only: each command parses its options and calls the library. Errors from the
@@ -20,6 +20,7 @@ import click
 from rtcli import __version__
 from rtcli.cli.compare import compare
 from rtcli.cli.explain import explain
+from rtcli.cli.info import info
 from rtcli.cli.preview import preview
 from rtcli.cli.render import render
 from rtcli.cli.signature import signature
@@ -93,5 +94,5 @@ def main(debug):
     # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
-for _command in (render, signature, explain, compare, validate, preview, presets, warmup):
+for _command in (render, signature, explain, compare, info, validate, preview, presets, warmup):
     main.add_command(_command)

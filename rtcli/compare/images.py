@@ -204,11 +204,15 @@ def heat_map(actual, expected, tolerance: int = 2) -> np.ndarray:
         raise RtcliError(differs.summary.removeprefix("FAIL: "))
     out = np.empty(actual.shape, dtype=np.uint8)
     for y in range(0, actual.shape[0], BAND):
-        e = _band_errors(actual[y:y + BAND], expected[y:y + BAND])[0].astype(np.int32)
-        t = np.where(e > 0, np.minimum(255, 32 + 8 * e), 0)
-        t = np.where(e > tolerance, np.maximum(t, 128), t)
-        out[y:y + BAND] = np.clip(3 * t[..., None] - np.array([0, 255, 510], np.int32), 0, 255)
+        out[y:y + BAND] = ramp(_band_errors(actual[y:y + BAND], expected[y:y + BAND])[0].astype(np.int32), tolerance)
     return out
+
+
+def ramp(e: np.ndarray, tolerance: int) -> np.ndarray:
+    """The heat map's colors (see heat_map) of per-pixel errors e (integers 0..255)."""
+    t = np.where(e > 0, np.minimum(255, 32 + 8 * e), 0)
+    t = np.where(e > tolerance, np.maximum(t, 128), t)
+    return np.clip(3 * t[..., None] - np.array([0, 255, 510], np.int32), 0, 255).astype(np.uint8)
 
 
 def read_png(path) -> np.ndarray:

@@ -27,6 +27,7 @@ img.broken { outline: 3px solid #d00; min-width: 40px; min-height: 30px; }
 .error .status { background: #d06000; }
 .result { margin-left: 4px; font-size: 12px; color: #555; }
 .total { font-weight: bold; }
+.note { font-size: 12px; max-width: 24em; color: #6a4a00; background: #fff4d6; padding: 2px 4px; margin-top: 4px; }
 """
 
 LOADED = """
@@ -70,6 +71,7 @@ actual one, such as a scene that failed to render, or an unreadable file), then 
 def _row(k: int, pair: Pair, names: dict, columns: list[str]) -> str:
     cells = "".join(_cell(names.get(c), c, pair.path) for c in columns)
     flip = f"<div>mean FLIP {pair.flip_mean:.4f}</div>" if pair.flip_mean is not None else ""
+    flip += "".join(f'<div class="note">{escape(note)}</div>' for note in pair.notes)
     kind, result = ("", "") if pair.ok else (f" {pair.result}", f'<span class="result">{pair.result}</span>')
     return (f'<tr class="pair {pair.status}{kind}" id="pair-{k}"><td><div class="path">{escape(pair.path)}</div>'
             f'<span class="status">{escape(pair.status)}</span>{result}'

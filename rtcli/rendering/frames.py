@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import re
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -22,6 +23,7 @@ from PIL import Image, UnidentifiedImageError
 
 from rtcli.errors import RtcliError, shown
 from rtcli.rendering.movie import check_size, is_movie, movie_format, write_movie
+from rtcli.rendering.provenance import provenance
 from rtcli.rendering.tiles import render as render_tiles
 from rtcli.rendering.writer import write_png
 from rtcli.scenefile.animation import Animation
@@ -134,17 +136,30 @@ def render_sequence(loaded, seq: Sequence, job, skip_existing: bool, frames: Cal
         if k != loaded.frame:
             loaded.animation.scene(k)                          # every frame checked before any is rendered
     movie = {k: _read_back(seq.paths[k], job) for k in seq.frames if k not in todo and seq.movies}
-    stats = Stats()
+    stats, start, total = Stats(), time.perf_counter(), 0.0
     for k, image, s in frames(todo) if todo else ():
+        seconds = time.perf_counter() - start
+        total += seconds
         if k in seq.paths:
-            write_png(seq.paths[k], image)
+            write_png(seq.paths[k], image, frame_meta(loaded, job, k, s.engine, seconds))
         if seq.movies:
             movie[k] = image
         stats.add(s)
         stats.engine = s.engine
+        start = time.perf_counter()
+    frame_range = f"{seq.frames[0]}-{seq.frames[-1]}" if seq.frames else "-"
     for path in seq.movies:
-        write_movie(path, [movie[k] for k in seq.frames], loaded.animation.clock.fps)
+        write_movie(path, [movie[k] for k in seq.frames], loaded.animation.clock.fps,
+                    frame_meta(loaded, job, frame_range, stats.engine, total))
     return stats
+
+
+def frame_meta(loaded, job, frame, engine: str, seconds: float) -> dict[str, str]:
+    """The provenance of frame `frame`'s image (rendering/provenance.py), or of a movie's ("FIRST-LAST");
+    `seconds` from the end of the frame before (or the start) to this one's, or of the frames rendered."""
+    s = loaded.scene.settings
+    return provenance(loaded.path, job.width, job.height, samples=s.samples, max_depth=s.max_depth, frame=frame,
+                      block_size=job.block_size, gamma=job.gamma, engine=engine or "none", seconds=seconds)
 
 
 def local_frames(loaded, todo: list[int], job, workers: int, changes: dict, progress=None):

@@ -16,8 +16,10 @@ import os
 
 import numpy as np
 from PIL import Image
+from PIL.PngImagePlugin import PngInfo
 
 from rtcli.errors import RtcliError, quoted, shown
+from rtcli.rendering import provenance
 from rtcli.rendering.writer import write_atomic
 
 FORMATS = {".apng": "PNG", ".gif": "GIF"}
@@ -48,12 +50,20 @@ def check_size(frames: int, width: int, height: int) -> None:
                          "to files instead (-o frame_%04d.png)")
 
 
-def write_movie(path: str, frames: list[np.ndarray], fps: float) -> None:
-    """Write uint8 (H, W, 3) frames as a movie at `fps` frames a second, looping."""
+def write_movie(path: str, frames: list[np.ndarray], fps: float, meta: dict[str, str] | None = None) -> None:
+    """Write uint8 (H, W, 3) frames as a movie at `fps` frames a second, looping; `meta`, the
+    provenance (rendering/provenance.py), as an APNG's text chunks or a GIF's comment (JSON)."""
     fmt = movie_format(path)
     images = [Image.fromarray(f) for f in frames]
+    extra = {}
+    if meta and fmt == "PNG":
+        extra["pnginfo"] = PngInfo()
+        for key, value in meta.items():
+            extra["pnginfo"].add_text(key, value)
+    elif meta:
+        extra["comment"] = provenance.as_json(meta).encode("utf-8")
     write_atomic(path, lambda f: images[0].save(f, format=fmt, save_all=True, append_images=images[1:],
-                                                duration=delays(len(images), fps, TICK[fmt]), loop=0))
+                                                duration=delays(len(images), fps, TICK[fmt]), loop=0, **extra))
 
 
 def delays(frames: int, fps: float, tick: int) -> list[int]:

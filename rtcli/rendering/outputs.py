@@ -13,8 +13,9 @@ import os
 import stat
 
 from rtcli.errors import RtcliError, shown
+from rtcli.rendering.exr import LAYERS
 from rtcli.rendering.movie import movie_format
-from rtcli.rendering.writer import image_format
+from rtcli.rendering.writer import ALPHA, DEEP, FLOATS, image_format
 from rtcli.scenefile.files import kind_of
 
 
@@ -34,6 +35,27 @@ def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> N
         if real in seen:
             raise RtcliError(f"{shown(path)}: given for two outputs; they must differ")
         seen[real] = path
+
+
+def check_format_options(path: str, *, bit_depth: int = 8, half: bool = False, layers: tuple = (),
+                         alpha: bool = False, gamma: bool = False) -> None:
+    """RtcliError when the output's format cannot hold what is asked (README.md, Images): 16 bits
+    a channel go to PNG or TIFF, float16 and layers to EXR, alpha to PNG, TIFF, WebP or EXR, and
+    EXR and PFM hold linear radiance, never sRGB-encoded."""
+    ext = os.path.splitext(path)[1].lower()
+    unknown = [k for k in layers if k not in LAYERS]
+    why = next((why for bad, why in [
+        (bit_depth not in (8, 16), f"the bit depth is 8 or 16, not {bit_depth}"),
+        (bit_depth == 16 and ext not in DEEP, "16 bits a channel go to .png or .tif (.exr and .pfm hold floats)"),
+        (half and ext != ".exr", "float16 (--half) is for EXR: the name must end in .exr"),
+        (unknown, f"no layer {', '.join(map(str, unknown))}: layers are {', '.join(LAYERS)}"),
+        (layers and ext != ".exr", "layers go into a multi-layer EXR: the name must end in .exr"),
+        (alpha and ext not in ALPHA, "alpha (render: {alpha: true} or --alpha) needs a format with an alpha "
+                                     "channel: .png, .tif, .webp or .exr"),
+        (gamma and ext in FLOATS, "EXR and PFM hold the linear radiance; --gamma encodes 8- and 16-bit images"),
+    ] if bad), None)
+    if why:
+        raise RtcliError(f"{shown(path)}: {why}")
 
 
 def check_file_output(path: str, inputs: list[str]) -> None:

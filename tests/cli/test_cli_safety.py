@@ -126,10 +126,10 @@ def test_when_one_of_two_outputs_fails_none_is_left(run, tmp_path, monkeypatch):
     """signature -o X --ids Y: if Y cannot be written, X is not left either."""
     real = writer._write_temp
 
-    def failing(path, pixels):
+    def failing(path, pixels, *rest):
         if path.endswith("ids.png"):
             raise OSError(28, "No space left on device")
-        return real(path, pixels)
+        return real(path, pixels, *rest)
     monkeypatch.setattr(writer, "_write_temp", failing)
     assert one_error(run("signature", "s.yaml", "-o", "sig.png", "--ids", "ids.png", "--workers", "1")) == (
         "cannot write ids.png: No space left on device")

@@ -25,6 +25,7 @@ from collections import OrderedDict
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from helpers import same_image
 from PIL import Image
 
 from rtcli.api.loading import load_file
@@ -92,7 +93,8 @@ def run(tmp_path, monkeypatch):
 
 
 def same_files(tmp_path, a: str, b: str) -> bool:
-    return (tmp_path / a).read_bytes() == (tmp_path / b).read_bytes()
+    """The same pixels and provenance, but the engine (the workers' may be another) and the time."""
+    return same_image(tmp_path / a, tmp_path / b, ignore=("engine",))
 
 
 @pytest.mark.parametrize("rays_per_task", [sessions.RAYS_PER_TASK, 50])

@@ -90,7 +90,7 @@ def test_all_pairs_passing_exits_0(folders):
     (["actual", "expected", "--report", "actual/r"], "actual/r: the report folder must be outside the compared"),
     (["actual", "expected", "--report", "kept"], "kept: a folder that is neither empty nor an rtcli report"),
     (["actual", "expected", "--junit", "actual/same.png"], "actual/same.png: is an input of this run"),
-    (["empty", "empty"], "no .png images under empty or empty"),
+    (["empty", "empty"], "no .png, .exr or .pfm images under empty or empty"),
 ])
 def test_bad_usage_exits_2_and_writes_nothing(folders, args, message):
     (folders / "kept").mkdir()

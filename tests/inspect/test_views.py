@@ -7,6 +7,7 @@ import io
 
 import numpy as np
 import pytest
+from helpers import same_image
 from PIL import Image
 
 import rtcli
@@ -156,7 +157,7 @@ def test_render_view_ids_writes_the_id_map_that_compare_ids_reads(tmp_path, monk
     assert result.output == "ids: the signature's ids, 0 (background) to 2, as a 16-bit id map (rtcli signature " \
                             "draws them in colors)\n"
     assert CliRunner().invoke(main, ["signature", "s.yaml", "--ids", "sig.ids.png", "--workers", "1"]).exit_code == 0
-    assert (tmp_path / "s.ids.png").read_bytes() == (tmp_path / "sig.ids.png").read_bytes()
+    assert same_image(tmp_path / "s.ids.png", tmp_path / "sig.ids.png")
     assert Image.open(tmp_path / "s.ids.png").mode == "I;16"
     result = CliRunner().invoke(main, ["compare", "s.ids.png", "sig.ids.png", "--ids"])
     assert result.exit_code == 0 and result.output.startswith("OK: 0 mismatched ids"), result.output

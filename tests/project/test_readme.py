@@ -43,6 +43,10 @@ SMALLER = {
     "rtcli render scenes/orbit.yaml --frames 1-24 -o out/frame_%04d.png": "--width 32",
     "rtcli render scenes/orbit.yaml -o orbit.gif": "--width 32",
     "rtcli render dark.yaml": "--width 64",
+    "rtcli render scenes/whitted.yaml -o whitted.exr --layers normal,depth,albedo,ids": "--width 64",
+    "rtcli render scenes/whitted.yaml -o whitted.pfm": "--width 64",
+    "rtcli render scenes/whitted.yaml -o whitted16.png --bit-depth 16 --gamma": "--width 64",
+    "rtcli render scenes/whitted.yaml -o cutout.png --alpha": "--width 64",
 }
 
 # The README's line -> why it does not run here, and where it is tested.
@@ -82,6 +86,12 @@ EXPECTED = {
     "rtcli validate scenes/whitted.yaml --objects": (0, []),
     "rtcli validate dark.yaml": (0, []),
     "rtcli render dark.yaml": (0, ["dark.png"]),
+    "rtcli render scenes/whitted.yaml -o whitted.exr --layers normal,depth,albedo,ids": (0, ["whitted.exr"]),
+    "rtcli render scenes/whitted.yaml -o whitted.pfm": (0, ["whitted.pfm"]),
+    "rtcli render scenes/whitted.yaml -o whitted16.png --bit-depth 16 --gamma": (0, ["whitted16.png"]),
+    "rtcli render scenes/whitted.yaml -o cutout.png --alpha": (0, ["cutout.png"]),
+    "rtcli info whitted.exr": (0, []),
+    "rtcli compare whitted.pfm whitted.exr --float-tolerance 0.001": (0, []),
 }
 
 
