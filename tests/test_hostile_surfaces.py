@@ -1,0 +1,130 @@
+"""Hostile input on the newer surfaces: animation clocks and movies, --cluster-file, NUL bytes in paths.
+
+Every case keeps the rule of tests/test_hostile_input.py: one `error:` line, exit 2,
+no partial output file, in bounded time and memory.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+import zlib
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from rtcli.cli import main
+from rtcli.rendering import movie
+from rtcli.rendering.frames import _read_back
+from rtcli.rendering.tiles import Job
+
+SCENE = """\
+camera: {eye: [0, 0, 5], look_at: [0, 0, 0]}
+image: {width: 8, height: 6}
+lights: [{position: [5, 5, 5]}]
+objects: [{sphere: {}}]
+"""
+
+
+@pytest.fixture
+def run(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("RTCLI_NUMBA", "0")
+    runner = CliRunner()
+    return lambda *args: runner.invoke(main, list(args))
+
+
+def one_error(result) -> str:
+    assert result.exit_code == 2, result.output
+    assert result.output.startswith("error: ") and result.output.count("\n") == 1, result.output
+    return result.output[len("error: "):-1]
+
+
+def animated(tmp_path, section: str, name: str = "a.yaml") -> str:
+    (tmp_path / name).write_text(SCENE + f"animation: {section}\n")
+    return name
+
+
+def png_header(path, width: int, height: int, rows: int = 1) -> None:
+    """A PNG that says it is width x height, with `rows` rows of data (a decompression bomb's header)."""
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    head = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    data = zlib.compress(b"\0" * (width * 3 + 1) * rows, 9)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", head) + chunk(b"IDAT", data) + chunk(b"IEND", b""))
+
+
+# --- animation clocks ---
+@pytest.mark.parametrize("section", ["{clock: [0, 1e-12]}", "{fps: 1e-20, clock: [0, 5]}", "{fps: 24, clock: [3, 3.01]}"])
+def test_a_clock_shorter_than_a_frame_has_one_frame_at_its_start(run, tmp_path, section):
+    name = animated(tmp_path, section)
+    result = run("render", name, "-o", "f_%d.png")
+    assert result.exit_code == 0, result.output
+    assert sorted(os.listdir(tmp_path)) == [name, "f_1.png"]
+    assert run("validate", name).output.count("animated: 1 frame at ") == 1
+
+
+@pytest.mark.parametrize("section, where", [("{fps: 1e-20, frames: 2}", "5:18"), ("{fps: 5e-324, frames: 3}", "5:18"),
+                                            ("{frames: 100000, fps: 1e-16}", "5:34")])
+def test_frame_times_beyond_the_numbers_a_scene_holds_are_refused(run, tmp_path, section, where):
+    message = one_error(run("render", animated(tmp_path, section), "-o", "f_%d.png"))
+    assert message.startswith(f"a.yaml:{where}: animation.fps: ") and "more than the 1e+20 s a clock may span" in message
+    assert sorted(os.listdir(tmp_path)) == ["a.yaml"]
+
+
+# --- movies ---
+@pytest.mark.parametrize("ext, longest", [(".gif", "655.35"), (".apng", "65.535")])
+@pytest.mark.parametrize("fps", ["1e-20", "0.001"])
+def test_a_movie_frame_longer_than_its_format_holds_is_refused_before_rendering(run, tmp_path, ext, longest, fps):
+    name = animated(tmp_path, f"{{fps: {fps}, clock: [0, 3000]}}" if fps == "0.001" else f"{{fps: {fps}, clock: [0, 1]}}")
+    message = one_error(run("render", name, "-o", "m" + ext))
+    assert message.startswith(f"-o m{ext}: at {float(fps):g} fps a frame lasts ")
+    assert f"longer than the {longest} s a frame of" in message
+    assert sorted(os.listdir(tmp_path)) == [name]
+
+
+def test_a_slow_movie_within_its_formats_delays_is_written(tmp_path):
+    frames = [np.zeros((2, 2, 3), np.uint8), np.ones((2, 2, 3), np.uint8)]
+    for ext in ("apng", "gif"):
+        movie.check_rate(f"m.{ext}", 2, 0.02)                              # 50 s a frame
+        movie.write_movie(str(tmp_path / f"m.{ext}"), frames, 0.02)
+        with Image.open(tmp_path / f"m.{ext}") as m:
+            assert (m.n_frames, m.info["duration"]) == (2, 50000)
+
+
+def test_a_gif_of_identical_frames_longer_than_a_gif_frame_is_refused(tmp_path):
+    frames = [np.zeros((2, 2, 3), np.uint8)] * 700                   # 700 s at 1 fps, one picture
+    with pytest.raises(movie.RtcliError, match=r"^-o .*m\.gif: frames 1-656 are the same picture, which a GIF "):
+        movie.write_movie(str(tmp_path / "m.gif"), frames, 1.0)
+    assert os.listdir(tmp_path) == []
+    frames[300] = np.ones((2, 2, 3), np.uint8)                          # 300 s, 1 s, 399 s: a GIF holds it
+    movie.write_movie(str(tmp_path / "m.gif"), frames, 1.0)
+    with Image.open(tmp_path / "m.gif") as m:
+        assert m.n_frames == 3
+    movie.write_movie(str(tmp_path / "m.apng"), [frames[0]] * 700, 1.0)    # an APNG splits the run
+
+
+def test_skip_existing_never_decodes_a_bomb_among_the_earlier_frames(run, tmp_path):
+    name = animated(tmp_path, "{fps: 4, frames: 3}")
+    png_header(tmp_path / "f_1.png", 100_000, 100_000)                # 10^10 pixels said, 370 bytes
+    png_header(tmp_path / "f_2.png", 12_000, 10_000)                  # Pillow's warning zone
+    result = run("render", name, "-o", "f_%d.png", "--movie", "m.gif", "--skip-existing")
+    assert result.exit_code == 0 and result.output == "", result.output
+    for k in (1, 2, 3):                                               # of another size: rendered again
+        with Image.open(tmp_path / f"f_{k}.png") as img:
+            assert img.size == (8, 6)
+
+
+def test_an_earlier_frame_read_back_is_checked_from_its_header(tmp_path):
+    threshold = Image.MAX_IMAGE_PIXELS
+    png_header(tmp_path / "f.png", 100_000, 100_000)
+    with pytest.raises(movie.RtcliError, match=r"f\.png: an earlier frame larger than 8x6: render it again"):
+        _read_back(str(tmp_path / "f.png"), Job(8, 6))
+    png_header(tmp_path / "f.png", 8, 5, rows=5)
+    with pytest.raises(movie.RtcliError, match=r"f\.png: an earlier frame of 8x5, not 8x6"):
+        _read_back(str(tmp_path / "f.png"), Job(8, 6))
+    png_header(tmp_path / "f.png", 8, 6, rows=6)
+    assert _read_back(str(tmp_path / "f.png"), Job(8, 6)).shape == (6, 8, 3)
+    assert Image.MAX_IMAGE_PIXELS == threshold                                   # put back
