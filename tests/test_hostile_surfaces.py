@@ -128,3 +128,36 @@ def test_an_earlier_frame_read_back_is_checked_from_its_header(tmp_path):
     png_header(tmp_path / "f.png", 8, 6, rows=6)
     assert _read_back(str(tmp_path / "f.png"), Job(8, 6)).shape == (6, 8, 3)
     assert Image.MAX_IMAGE_PIXELS == threshold                                   # put back
+
+
+# --- --cluster-file ---
+def cluster_file_error(run, tmp_path, path) -> str:
+    (tmp_path / "s.yaml").write_text(SCENE)
+    message = one_error(run("render", "s.yaml", "--cluster-file", str(path), "-o", "out.png"))
+    assert not (tmp_path / "out.png").exists()
+    return message.replace(str(tmp_path) + "/", "")
+
+
+@pytest.mark.parametrize("make, reason", [
+    (lambda p: os.mkfifo(p), "sched.json: not a regular file but a FIFO (named pipe)"),
+    (lambda p: os.mkdir(p), "sched.json: not a regular file but a folder"),
+    (lambda p: p.write_text(" " * 65537), "sched.json: too large for a scheduler file: 65,537 bytes, more than the 65,536 allowed"),
+    (lambda p: p.write_text("[" * 60000), "sched.json: not a Dask scheduler file: its JSON nests too deep"),
+    (lambda p: p.write_text('{"address":\n  tcp}'), "sched.json: not a Dask scheduler file (Expecting value: line 2 column 3 (char 14))"),
+    (lambda p: p.write_bytes(b'{"address": "\xff"}'), "sched.json: not a Dask scheduler file: byte 13 is not UTF-8"),
+    (lambda p: p.write_text('["tcp://127.0.0.1:8786"]'), 'sched.json: names no scheduler address (a JSON object with "address")'),
+])
+def test_a_cluster_file_is_a_small_regular_json_file(run, tmp_path, make, reason):
+    make(tmp_path / "sched.json")
+    assert cluster_file_error(run, tmp_path, tmp_path / "sched.json") == f"--cluster-file {reason}"
+
+
+def test_a_cluster_file_that_is_a_device_is_never_read(run, tmp_path):
+    message = cluster_file_error(run, tmp_path, "/dev/zero")
+    assert message == "--cluster-file /dev/zero: not a regular file but a character device"
+
+
+def test_a_cluster_file_gives_its_address(tmp_path):
+    from rtcli.cluster.schedulerfile import scheduler_address
+    (tmp_path / "s.json").write_text('{"type": "Scheduler", "address": "tcp://127.0.0.1:8786", "workers": {}}')
+    assert scheduler_address(str(tmp_path / "s.json")) == "tcp://127.0.0.1:8786"
