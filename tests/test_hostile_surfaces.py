@@ -161,3 +161,26 @@ def test_a_cluster_file_gives_its_address(tmp_path):
     from rtcli.cluster.schedulerfile import scheduler_address
     (tmp_path / "s.json").write_text('{"type": "Scheduler", "address": "tcp://127.0.0.1:8786", "workers": {}}')
     assert scheduler_address(str(tmp_path / "s.json")) == "tcp://127.0.0.1:8786"
+
+
+# --- folder comparison: names of any bytes ---
+def test_report_and_junit_show_names_that_are_not_utf8(run, tmp_path):
+    import xml.etree.ElementTree as ET
+    actual, expected = os.fsencode(tmp_path / "act\udcff"), os.fsencode(tmp_path / "exp\n")
+    for folder, shade in ((actual, 0), (expected, 50)):
+        os.mkdir(folder)
+        Image.fromarray(np.full((4, 4, 3), shade, np.uint8)).save(folder + b"/x\xff\xfe<b>.png")
+    Image.fromarray(np.zeros((4, 4, 3), np.uint8)).save(expected + b"/gold\x80\".png")
+    result = run("compare", os.fsdecode(actual), os.fsdecode(expected), "--report", "rep", "--junit", "j.xml")
+    assert result.exit_code == 1, result.output
+    lines = result.output.replace(str(tmp_path), "T").splitlines()
+    assert lines == ["'gold\\x80\".png': MISSING: no actual image for 'T/exp\\n/gold\\x80\".png'",
+                     "'x\\xff\\xfe<b>.png': FAIL: 16 bad pixels (limit 16), largest cluster 16 px at (x=0, y=0), "
+                     "max error 50/255 at (x=0, y=0), mean error 50.00/255",
+                     "FAIL: 2 pairs: 0 ok, 1 failing, 1 missing, 0 extra, 0 unreadable"]
+    page = (tmp_path / "rep" / "index.html").read_text(encoding="utf-8")
+    assert '<div class="path">x\\xff\\xfe&lt;b&gt;.png</div>' in page
+    assert '<div class="path">gold\\x80&quot;.png</div>' in page and "act\\xff against " in page
+    assert "exp\\n" in page and "<b>" not in page
+    names = [case.get("name") for case in ET.parse(tmp_path / "j.xml").iter("testcase")]
+    assert names == ['gold\\x80".png', "x\\xff\\xfe<b>.png"]
