@@ -19,7 +19,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from PIL import Image
 
+from rtcli.api.options import check_options, check_path
 from rtcli.core.display import signature_colors, to_8bit
+from rtcli.errors import RtcliError
 from rtcli.rendering.outputs import check_outputs
 from rtcli.rendering.writer import write_png
 
@@ -110,8 +112,9 @@ class ImageArray(np.ndarray):
             return ImageArray(self.picture, inputs=self.inputs)
         if self.is_ids:
             return ImageArray(signature_colors(np.asarray(self)), inputs=self.inputs)
+        check_options(gamma=gamma)
         if self.ndim != 3 or self.shape[2] != 3:
-            raise ValueError(f"not an image: an array of shape {self.shape}")
+            raise RtcliError(f"not an image: an array of shape {self.shape}")
         if self.dtype == np.uint8:
             return self
         return ImageArray(to_8bit(np.asarray(self, dtype=float), gamma), inputs=self.inputs)
@@ -124,7 +127,7 @@ class ImageArray(np.ndarray):
         """Write the image as `rtcli render` (or an id map as `rtcli signature --ids`) would: the format
         follows the extension, the file is replaced atomically, and an input of the scene, a
         folder or a device is refused (RtcliError)."""
-        path = str(path)
+        path = check_path("path", path)
         check_outputs([(path, self.is_ids)], list(self.inputs))
         write_png(path, np.asarray(self if self.is_ids else self.to_8bit()))
 

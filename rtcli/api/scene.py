@@ -47,6 +47,8 @@ class Scene:
 
     def at(self, frame: int) -> Scene:
         """The scene of another frame, with the same overrides (itself for its own frame)."""
+        if frame is None:
+            raise RtcliError("frame must be an integer in 1..100000, got None")
         check_options(frame=frame)
         check_frame(self._animation, frame, self.source, "frame")
         if frame == self.frame:
@@ -58,6 +60,7 @@ class Scene:
     def override(self, width: int | None = None, height: int | None = None, samples: int | None = None,
                  max_depth: int | None = None) -> Scene:
         """Set the image size (width or height alone keeps the aspect ratio) and render settings; self."""
+        check_options(width=width, height=height, samples=samples, max_depth=max_depth)
         s = self.model.settings
         s.width, s.height, _ = image_size(self.model, width, height)
         s.samples, s.max_depth = samples or s.samples, max_depth or s.max_depth
