@@ -184,3 +184,22 @@ def test_report_and_junit_show_names_that_are_not_utf8(run, tmp_path):
     assert "exp\\n" in page and "<b>" not in page
     names = [case.get("name") for case in ET.parse(tmp_path / "j.xml").iter("testcase")]
     assert names == ['gold\\x80".png', "x\\xff\\xfe<b>.png"]
+
+
+# --- OBJ numbers beyond a scene's ---
+@pytest.mark.parametrize("line, message", [("v 1e300 0 0", "m.obj:2:3: number 1e300 in 'v' must be between -1e20 and 1e20"),
+                                           ("vn 0 -2e20 0", "m.obj:2:6: number -2e20 in 'vn' must be between -1e20 and 1e20")])
+def test_an_obj_number_beyond_a_scenes_is_one_line_without_numpys_warnings(tmp_path, line, message):
+    """Whichever reader reads the file (the bulk one here), the careful one names the number; no
+    RuntimeWarning of numpy on stderr. A subprocess, so stderr is all rtcli printed."""
+    import subprocess
+    import sys
+    (tmp_path / "m.obj").write_text(f"v 0 0 0\n{line}\nv 1e20 1 0\nv 0 1 0\nf 1 3 4\n")
+    (tmp_path / "s.yaml").write_text(SCENE.replace("{sphere: {}}", "{mesh: {file: m.obj}}"))
+    done = subprocess.run([sys.executable, "-m", "rtcli", "render", "s.yaml", "-o", "out.png"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120, env={**os.environ, "RTCLI_NUMBA": "0"})
+    assert (done.returncode, done.stdout, done.stderr) == (2, "", f"error: {message}\n")
+    assert not (tmp_path / "out.png").exists()
+    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1e20 0 0\nv 0 1e20 0\nf 1 2 3\n")          # at the limit: renders
+    assert subprocess.run([sys.executable, "-m", "rtcli", "render", "s.yaml", "-o", "out.png"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120, env={**os.environ, "RTCLI_NUMBA": "0"}).stderr == ""
