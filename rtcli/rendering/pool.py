@@ -43,8 +43,12 @@ def held_signals():
 
 def watch_worker() -> None:
     """In a worker: ignore SIGINT (the parent handles it), take SIGTERM again (it was forked while
-    the parent held it) and die when the parent dies."""
+    the parent held it) and die when the parent dies. SIGTERM ends a worker at once, by its
+    default action: the handler forked from the parent (cli.py's, which raises Interrupted) would
+    print a traceback from the worker when the signal came while it starts or waits for a tile;
+    the parent reports the death as the interrupt it is (worker_died)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)
     try:
@@ -59,7 +63,14 @@ def _processes(pool) -> list:
 
 
 def stop_pool(pool, finished: bool) -> None:
-    """Shut the pool down; unless every tile is done, cancel the rest and kill the workers first."""
+    """Shut the pool down; unless every tile is done, cancel the rest and kill the workers first.
+
+    Either way the pool's manager thread has ended on return (within a bound when the workers
+    were killed). Left running, it closes its wake-up pipe while the interpreter's exit
+    (concurrent.futures' _python_exit, which takes no lock) may be writing to it: an
+    `OSError: [Errno 9] Bad file descriptor` traceback after rtcli's own `error: interrupted`,
+    now and then, when a signal reached the parent alone.
+    """
     if finished:
         pool.shutdown(wait=True)
         return
@@ -67,9 +78,12 @@ def stop_pool(pool, finished: bool) -> None:
     for p in workers:
         if p.exitcode is None:
             p.kill()
+    manager = getattr(pool, "_executor_manager_thread", None)
     pool.shutdown(wait=False, cancel_futures=True)
     for p in workers:
         p.join(timeout=5)
+    if manager is not None:
+        manager.join(timeout=5)                 # the workers are dead: it sees the pool broken and ends
 
 
 def _exit_codes(workers: list, wait: float = 1.0) -> list[int]:
