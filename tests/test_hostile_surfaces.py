@@ -74,6 +74,14 @@ def test_frame_times_beyond_the_numbers_a_scene_holds_are_refused(run, tmp_path,
     assert sorted(os.listdir(tmp_path)) == ["a.yaml"]
 
 
+@pytest.mark.parametrize("pattern", ["f_%0100d.png", "f_%999999999999d.png"])
+def test_a_frame_number_as_wide_as_memory_is_refused(run, tmp_path, pattern):
+    """`output % k` would build a name of a trillion characters (or one no folder can hold)."""
+    message = one_error(run("render", animated(tmp_path, "{fps: 4, frames: 2}"), "-o", pattern))
+    assert message.startswith(f"-o {pattern}: a frame pattern has one %d (or %04d ..., a width below 100)")
+    assert sorted(os.listdir(tmp_path)) == ["a.yaml"]
+
+
 # --- movies ---
 @pytest.mark.parametrize("ext, longest", [(".gif", "655.35"), (".apng", "65.535")])
 @pytest.mark.parametrize("fps", ["1e-20", "0.001"])

@@ -29,7 +29,7 @@ from rtcli.rendering.writer import write_png
 from rtcli.scenefile.animation import Animation
 from rtcli.stats import Stats
 
-PATTERN = re.compile(r"(?:[^%]|%%)*%0?[1-9]?\d*d(?:[^%]|%%)*", re.DOTALL)    # exactly one %d, %04d ...
+PATTERN = re.compile(r"(?:[^%]|%%)*%0?(?:[1-9]\d?)?d(?:[^%]|%%)*", re.DOTALL)  # one %d, %04d ... (width < 100)
 
 
 def _frames_of(animation: Animation, scene_file: str) -> str:
@@ -81,8 +81,8 @@ def sequence(animation: Animation, scene_file: str, output: str | None, frames: 
     if output and not is_movie(output):
         if "%" in output:
             if not PATTERN.fullmatch(output):
-                raise RtcliError(f"-o {shown(output)}: a frame pattern has one %d (or %04d ...) for the frame "
-                                 "number, and %% for a percent sign")
+                raise RtcliError(f"-o {shown(output)}: a frame pattern has one %d (or %04d ..., a width below "
+                                 "100) for the frame number, and %% for a percent sign")
             return Sequence(wanted, {k: output % k for k in wanted}, movies)
         if len(wanted) > 1:
             raise RtcliError(f"-o {shown(output)}: {len(wanted)} frames need a name with the frame number "
