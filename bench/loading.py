@@ -46,7 +46,7 @@ def phases(repeat: int) -> None:
     sys.path.insert(0, ROOT)
     import numpy as np
 
-    from rtcli import variants
+    from rtcli.kernels import variants
     from rtcli.compiled import build as compiled_build
     from rtcli.core import bvh_build
     from rtcli.scenefile import load, yamlfile

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from bvh_reference import build as reference_build
 
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.compiled import build as compiled_build
 from rtcli.core import bvh_build
 from rtcli.core.bvh import BVH

@@ -17,7 +17,7 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.cli import main
 from rtcli.rendering import writer
 

@@ -27,7 +27,7 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from rtcli import variants
+from rtcli.kernels import numba_cache, variants
 from rtcli.api.loading import load_file
 from rtcli.cli import main
 from rtcli.cli import terminal as runs
@@ -458,11 +458,11 @@ def test_a_cold_worker_process_compiles_and_says_so(run, tmp_path):
     from test_startup import WALKS, seeded
 
     from rtcli.rendering.warmup import warmup
-    if variants.cache_location().root is not None:
+    if numba_cache.cache_location().root is not None:
         pytest.skip("the cache is not beside the sources here (RTCLI_CACHE_DIR or NUMBA_CACHE_DIR is set)")
     warmup(notes=lambda text: None)                     # the cache to seed from, warm
-    cache = seeded(tmp_path / "cache", WALKS)
-    env = {variants.CACHE_ENV: str(cache), "RTCLI_MACHINE_CODE": "0"}
+    seeded_cache = seeded(tmp_path / "cache", WALKS)
+    env = {numba_cache.CACHE_ENV: str(seeded_cache), "RTCLI_MACHINE_CODE": "0"}
     cold = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
                                     dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL, env=env)
     try:
@@ -473,7 +473,7 @@ def test_a_cold_worker_process_compiles_and_says_so(run, tmp_path):
     assert result.exit_code == 0, result.output
     worker = result.stdout.split(": ")[0]
     assert result.stderr.splitlines() == [
-        f"note: worker {worker}: compiling the numpy engine's BVH walks, once (about half a minute); cached in {cache}",
+        f"note: worker {worker}: compiling the numpy engine's BVH walks, once (about half a minute); cached in {seeded_cache}",
         result.stderr.splitlines()[1]]
     assert result.stderr.splitlines()[1].startswith(f"note: worker {worker}: compiled in ")
     assert result.stdout.startswith(f"{worker}: compiled in ") and "the numpy engine's BVH walks" in result.stdout

@@ -15,7 +15,7 @@ import pytest
 from helpers import without_avx512
 
 from rtcli import compiled as fast
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.errors import RtcliError
 from rtcli.rendering.engine import AUTO_RAYS, choose
 from rtcli.rendering.tiles import Job, render, render_tile
@@ -245,10 +245,9 @@ def test_choose_falls_back_to_numpy_or_says_why(monkeypatch):
 def test_a_source_change_drops_the_cached_machine_code(tmp_path, monkeypatch):
     """numba alone would keep machine code built from an older sphere.py inside the integrator's cache."""
     package = tmp_path / "rtcli"
-    for folder in ("core", "shapes", "compiled"):
+    for folder in ("kernels", "core", "shapes", "compiled"):
         (package / folder / "__pycache__").mkdir(parents=True)
         (package / folder / "a.py").write_text(f"# {folder}\n")
-    (package / "variants.py").write_text("# ops\n")
     stale = [package / folder / "__pycache__" / "a.f-1.py311.nbi" for folder in ("core", "shapes", "compiled")]
     monkeypatch.setattr(fast, "PACKAGE", package)
 

@@ -7,6 +7,7 @@ import pytest
 
 from rtcli.core.transform import translate
 from rtcli.errors import SceneError
+from rtcli.kernels import variants
 from rtcli.shapes.base import Shape
 from rtcli.shapes.csg import CSG, OPS, Child
 from rtcli.shapes.sphere import Sphere
@@ -185,7 +186,7 @@ def decode(csg: CSG, prim: int, leaves: list):
 def test_one_ray_at_a_time_the_span_algebra_is_the_numpy_engines(seed):
     """`combine` (plain Python here, compiled in the compiled engine) gives every ray the numpy
     engine's spans, boundary for boundary with the same leaf and surface, and `nearest` its hit."""
-    from rtcli import variants
+
     from rtcli.shapes import csg as algebra
     combine, nearest = variants.python(algebra.combine), variants.python(algebra.nearest)
     rng = np.random.default_rng(seed)

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from helpers import avx512_features, without_avx512
 
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.core import elementary
 
 FUNCTIONS = {"power": 2, "arctan2": 2, "arcsin": 1, "arccos": 1, "cbrt": 1, "cos": 1, "sin": 1}

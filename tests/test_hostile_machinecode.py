@@ -17,7 +17,7 @@ import pytest
 from PIL import Image
 
 from rtcli import compiled as fast
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.compiled import build as compiled_build
 from rtcli.kernels import machinecode
 from rtcli.kernels.machinecode import entries, places, writing

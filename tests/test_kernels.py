@@ -1,5 +1,5 @@
 """Every kernel's variants agree (Mitsuba's check_vectorization): the numpy variant on arrays,
-the compiled one (numba) and the plain-Python one ray at a time (rtcli/variants.py).
+the compiled one (numba) and the plain-Python one ray at a time (rtcli/kernels/variants.py).
 
 The shape battery runs on every shape of the registry, through each class's examples(), so
 a shape added to rtcli/shapes/ is tested here without editing this file. For each: random
@@ -17,7 +17,7 @@ from math import atan2 as c_atan2
 import numpy as np
 import pytest
 
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.core import transform as tf
 from rtcli.shapes import SHAPES
 

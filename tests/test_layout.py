@@ -109,3 +109,59 @@ def test_imports_run_down_the_floors(floor, forbidden):
 def test_the_top_level_keeps_a_few_modules_every_floor_uses():
     flat = sorted(p.name for p in PACKAGE.glob("*.py") if p.name not in ("__init__.py", "__main__.py"))
     assert len(flat) <= 4, flat
+
+
+def too_long(path: Path, file_lines: int = 300, function_lines: int = 60) -> list[str]:
+    """What in a file is longer than the layout allows: the file itself, or a function."""
+    text = path.read_text()
+    found = [f"{path.name}: {len(text.splitlines())} lines"] if len(text.splitlines()) > file_lines else []
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            length = node.end_lineno - node.lineno + 1
+            if length > function_lines:
+                found.append(f"{path.name}:{node.lineno} {node.name}: {length} lines")
+    return found
+
+
+def test_no_file_over_300_lines_and_no_function_over_60():
+    assert [item for path in modules().values() for item in too_long(path)] == []
+
+
+def test_a_long_function_is_found(tmp_path):
+    source = tmp_path / "m.py"
+    source.write_text("def f():\n" + "    x = 1\n" * 60 + "\n\ndef g():\n    pass\n")
+    assert too_long(source) == ["m.py:1 f: 61 lines"]
+    assert too_long(source, file_lines=10) == ["m.py: 65 lines", "m.py:1 f: 61 lines"]
+
+
+def unexplained_imports(path: Path) -> list[int]:
+    """The lines of imports inside functions with no comment saying why they wait: a run of imports
+    one after another needs one comment among them."""
+    text = path.read_text()
+    lines, found = text.splitlines(), []
+    for function in ast.walk(ast.parse(text)):
+        if not isinstance(function, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue
+        for block in (getattr(n, field, None) for n in ast.walk(function) for field in ("body", "orelse", "finalbody")):
+            run = []
+            for statement in (block if isinstance(block, list) else []) + [None]:
+                if isinstance(statement, (ast.Import, ast.ImportFrom)):
+                    run.append(statement)
+                    continue
+                if run and not any("#" in line for line in lines[run[0].lineno - 1:run[-1].end_lineno]):
+                    found.append(run[0].lineno)
+                run = []
+    return sorted(set(found))
+
+
+def test_imports_inside_functions_say_why_they_wait():
+    """Imports are at module level unless start-up time or an optional extra needs them to wait,
+    and then a comment says so."""
+    assert {name: lines for name, path in modules().items() if (lines := unexplained_imports(path))} == {}
+
+
+def test_an_unexplained_import_is_found(tmp_path):
+    source = tmp_path / "m.py"
+    source.write_text("def f():\n    import json\n    import csv\n\n\ndef g():\n"
+                      "    import json  # start-up\n    import csv\n    if x:\n        import zlib\n")
+    assert unexplained_imports(source) == [2, 10]

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from rtcli import compiled as fast
-from rtcli import variants
+from rtcli.kernels import numba_cache, variants
 from rtcli.compiled import build as compiled_build
 from rtcli.core import bvh_build
 from rtcli.kernels import machinecode
@@ -383,8 +383,8 @@ def test_rtcli_makes_its_cache_folders_for_this_user_alone(tmp_path):
     old = os.umask(0o002)
     try:
         root = tmp_path / "cache" / "rtcli"
-        assert variants.writable(str(root))
-        location = variants._private_location(variants.CacheLocation(str(root), "test"))
+        assert numba_cache.writable(str(root))
+        location = numba_cache._private_location(numba_cache.CacheLocation(str(root), "test"))
     finally:
         os.umask(old)
     made = [tmp_path / "cache", root, *map(Path, location.folders())]

@@ -21,7 +21,7 @@ from PIL import Image
 from preview_helpers import GREEN, LOOK, Page, Preview, read_page, save, write_scene
 
 import rtcli
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.cli import main
 from rtcli.inspect import views
 from rtcli.preview import server

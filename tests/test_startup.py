@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from rtcli import compiled as fast
-from rtcli import variants
+from rtcli.kernels import numba_cache, variants
 from rtcli.compiled import loading
 from rtcli.kernels.machinecode import entries, places
 from rtcli.rendering.engine import choose
@@ -36,7 +36,7 @@ WALKS = "bvh.walk_rays_*.nbi"
 @pytest.fixture(scope="module")
 def warm():
     """The cache beside the sources, warm (a minute the first time if it is not)."""
-    if variants.cache_location().root is not None:
+    if numba_cache.cache_location().root is not None:
         pytest.skip("the cache is not beside the sources here (RTCLI_CACHE_DIR or NUMBA_CACHE_DIR is set)")
     from rtcli.rendering.warmup import warmup
     warmup(notes=lambda text: None)
@@ -46,7 +46,7 @@ def rtcli(*args, env=None, cwd=ROOT):
     """`python -m rtcli ARGS` in a process of its own: (exit code, stdout, stderr). In a cache of
     its own (env) it writes no machine code files (tests/test_machinecode.py has those): the
     tests here are about numba's cache, and each file takes seconds to write."""
-    environment = {k: v for k, v in os.environ.items() if k not in (variants.CACHE_ENV, "NUMBA_CACHE_DIR")}
+    environment = {k: v for k, v in os.environ.items() if k not in (numba_cache.CACHE_ENV, "NUMBA_CACHE_DIR")}
     if env:
         environment["RTCLI_MACHINE_CODE"] = "0"
     environment.update(env or {})
@@ -59,9 +59,9 @@ def seeded(root: Path, *without: str) -> Path:
     """A cache folder laid out as numba lays out NUMBA_CACHE_DIR (a folder per source folder),
     holding the warm cache's files but the index files matching `without` (those functions
     compile there, loading the functions they call)."""
-    for d in variants.COMPILED_DIRS:
-        source = Path(variants.PACKAGE_DIR, d)
-        target = root / variants.numba_subfolder(str(source))
+    for d in numba_cache.COMPILED_DIRS:
+        source = Path(numba_cache.PACKAGE_DIR, d)
+        target = root / numba_cache.numba_subfolder(str(source))
         target.mkdir(parents=True, exist_ok=True)
         for f in (source / "__pycache__").glob("*"):
             if f.suffix in (".nbi", ".nbc", ".sha256"):
@@ -77,7 +77,7 @@ def seeded(root: Path, *without: str) -> Path:
 def test_warmup_says_where_the_cache_is_and_then_that_it_is_warm(warm):
     code, out, err = rtcli("warmup")
     assert code == 0, err
-    assert f"cache: {os.path.join(variants.PACKAGE_DIR, '*', '__pycache__')} (beside the sources)" in out
+    assert f"cache: {os.path.join(numba_cache.PACKAGE_DIR, '*', '__pycache__')} (beside the sources)" in out
     assert "the render engine (compiled): loaded from the cache" in out
     assert "the numpy engine's BVH walks: loaded from the cache" in out
     assert "warm: nothing to compile" in out and "compiling" not in err
@@ -85,10 +85,10 @@ def test_warmup_says_where_the_cache_is_and_then_that_it_is_warm(warm):
 
 def test_the_compile_note_appears_exactly_when_compiling(warm, tmp_path):
     cache = seeded(tmp_path / "cache", WALKS)
-    env = {variants.CACHE_ENV: str(cache)}
+    env = {numba_cache.CACHE_ENV: str(cache)}
     code, out, err = rtcli("warmup", env=env)
     assert code == 0, err
-    assert f"cache: {cache} ({variants.CACHE_ENV})" in out
+    assert f"cache: {cache} ({numba_cache.CACHE_ENV})" in out
     assert err.splitlines()[0] == f"note: compiling the numpy engine's BVH walks, once (about half a minute); " \
                                   f"cached in {cache}"
     assert err.splitlines()[1].startswith("note: compiled in ") and len(err.splitlines()) == 2
@@ -101,7 +101,7 @@ def test_the_compile_note_appears_exactly_when_compiling(warm, tmp_path):
 
 def test_a_render_that_compiles_says_so_and_keeps_it_out_of_the_render_time(warm, tmp_path):
     cache = seeded(tmp_path / "cache", TRACE_CAMERA)
-    env = {variants.CACHE_ENV: str(cache)}
+    env = {numba_cache.CACHE_ENV: str(cache)}
     args = ("render", str(ROOT / "scenes" / "whitted.yaml"), "-o", str(tmp_path / "a.png"), "--width", "64",
             "--engine", "compiled", "--workers", "1", "--stats", "--json")
     code, out, err = rtcli(*args, env=env)
@@ -131,23 +131,23 @@ def test_the_stats_line_puts_compiling_apart():
 
 def test_a_read_only_install_caches_per_user(tmp_path, monkeypatch):
     """Simulated: the sources' folders are not writable (as root, chmod would not stop a write)."""
-    real = variants.writable
-    monkeypatch.setattr(variants, "writable", lambda f: not f.startswith(variants.PACKAGE_DIR) and real(f))
+    real = numba_cache.writable
+    monkeypatch.setattr(numba_cache, "writable", lambda f: not f.startswith(numba_cache.PACKAGE_DIR) and real(f))
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "home-cache"))
-    for name in (variants.CACHE_ENV, "NUMBA_CACHE_DIR"):
+    for name in (numba_cache.CACHE_ENV, "NUMBA_CACHE_DIR"):
         monkeypatch.delenv(name, raising=False)
-    variants.cache_location.cache_clear()
+    numba_cache.cache_location.cache_clear()
     try:
-        where = variants.cache_location()
+        where = numba_cache.cache_location()
         if sys.platform.startswith("linux"):
             assert where.root == str(tmp_path / "home-cache" / "rtcli" / "numba")
         assert where.enabled and "read-only" in where.why and str(where) == where.root
-        assert where.folders()[0] == os.path.join(where.root, variants.numba_subfolder(variants.PACKAGE_DIR))
+        assert where.folders()[0] == os.path.join(where.root, numba_cache.numba_subfolder(os.path.join(numba_cache.PACKAGE_DIR, "kernels")))
         monkeypatch.setenv("XDG_CACHE_HOME", "/proc/no-such-folder")          # nowhere writable: no cache
-        variants.cache_location.cache_clear()
-        assert not variants.cache_location().enabled
+        numba_cache.cache_location.cache_clear()
+        assert not numba_cache.cache_location().enabled
     finally:
-        variants.cache_location.cache_clear()
+        numba_cache.cache_location.cache_clear()
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="XDG_CACHE_HOME places the per-user cache on Linux")
@@ -156,14 +156,14 @@ def test_numba_writes_to_the_per_user_cache_when_the_sources_are_read_only(warm,
     user = tmp_path / "user-cache"
     cache = seeded(user / "rtcli" / "numba", TRACE_CAMERA)
     code = textwrap.dedent("""
-        from rtcli import variants
+        from rtcli.kernels import numba_cache, variants
         from rtcli.kernels import machinecode
-        real = variants.writable
-        variants.writable = lambda f: not f.startswith(variants.PACKAGE_DIR) and real(f)
+        real = numba_cache.writable
+        numba_cache.writable = lambda f: not f.startswith(numba_cache.PACKAGE_DIR) and real(f)
         from rtcli.cli import main
         main(["warmup"])
     """)
-    env = {k: v for k, v in os.environ.items() if k not in (variants.CACHE_ENV, "NUMBA_CACHE_DIR")}
+    env = {k: v for k, v in os.environ.items() if k not in (numba_cache.CACHE_ENV, "NUMBA_CACHE_DIR")}
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=900,
                           env={**env, "XDG_CACHE_HOME": str(user), "HOME": str(tmp_path), "RTCLI_MACHINE_CODE": "0"})
     assert done.returncode == 0, done.stderr
@@ -175,13 +175,13 @@ def test_numba_writes_to_the_per_user_cache_when_the_sources_are_read_only(warm,
 @pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0, reason="needs a user that chmod can stop")
 def test_a_read_only_copy_of_rtcli_uses_the_per_user_cache(tmp_path):
     copy = tmp_path / "site" / "rtcli"
-    shutil.copytree(Path(variants.PACKAGE_DIR), copy, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(Path(numba_cache.PACKAGE_DIR), copy, ignore=shutil.ignore_patterns("__pycache__"))
     for folder in [copy, *(p for p in copy.rglob("*") if p.is_dir())]:
         folder.chmod(0o555)
     try:
         code = "from rtcli import variants as v; w = v.cache_location(); print(v.PACKAGE_DIR, w.root, w.why)"
         env = {**os.environ, "PYTHONPATH": str(copy.parent), "XDG_CACHE_HOME": str(tmp_path / "c")}
-        env.pop(variants.CACHE_ENV, None), env.pop("NUMBA_CACHE_DIR", None)
+        env.pop(numba_cache.CACHE_ENV, None), env.pop("NUMBA_CACHE_DIR", None)
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
                              cwd=tmp_path, check=True).stdout.split(" ", 2)
         assert out[:2] == [str(copy), str(tmp_path / "c" / "rtcli" / "numba")] and "read-only" in out[2]
@@ -194,9 +194,9 @@ def test_numba_places_a_cache_root_as_rtcli_expects(tmp_path):
     """The stale-cache guard finds numba's files by these names; numba must agree."""
     from numba.core.caching import _CacheLocator
     from numba.misc.appdirs import AppDirs
-    for d in variants.COMPILED_DIRS:
-        source = os.path.join(variants.PACKAGE_DIR, d, "x.py")
-        assert variants.numba_subfolder(os.path.dirname(source)) == _CacheLocator.get_suitable_cache_subpath(source)
+    for d in numba_cache.COMPILED_DIRS:
+        source = os.path.join(numba_cache.PACKAGE_DIR, d, "x.py")
+        assert numba_cache.numba_subfolder(os.path.dirname(source)) == _CacheLocator.get_suitable_cache_subpath(source)
     assert fast._numba_user_cache() == AppDirs(appname="numba", appauthor=False).user_cache_dir
 
 
@@ -204,12 +204,11 @@ def test_the_stale_cache_guard_covers_every_place_the_cache_may_live(tmp_path, m
     """Beside the sources, RTCLI_CACHE_DIR, NUMBA_CACHE_DIR, the per-user cache and numba's own: a
     change in any source drops every cached file, a second look with the same sources keeps them."""
     package = tmp_path / "rtcli"
-    for folder in ("core", "shapes", "compiled"):
+    for folder in ("kernels", "core", "shapes", "compiled"):
         (package / folder).mkdir(parents=True)
         (package / folder / "a.py").write_text(f"# {folder}\n")
-    (package / "variants.py").write_text("# ops\n")
     monkeypatch.setattr(fast, "PACKAGE", package)
-    monkeypatch.setenv(variants.CACHE_ENV, str(tmp_path / "mine"))
+    monkeypatch.setenv(numba_cache.CACHE_ENV, str(tmp_path / "mine"))
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "numbas"))
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user"))
     monkeypatch.setenv("LOCALAPPDATA", str(tmp_path / "user"))
@@ -217,21 +216,20 @@ def test_the_stale_cache_guard_covers_every_place_the_cache_may_live(tmp_path, m
     places = fast.cache_places()
     assert len(places) == 5
     beside = {str(f) for f in places[0][0]}
-    assert beside == {str(package / d / "__pycache__") for d in ("compiled", "core", "shapes", "")} | \
-        {str(package / "__pycache__")}
+    assert beside == {str(package / d / "__pycache__") for d in ("compiled", "core", "shapes", "kernels")}
     files = [folder / "a.f-1.py311.nbi" for folders, _ in places for folder in folders]
     for f in files:
         f.parent.mkdir(parents=True, exist_ok=True)
 
-    def cache(text):
+    def look(text):
         for f in files:
             f.write_text(text)
         fast.drop_stale_cache()
         return [f.exists() for f in files]
-    assert cache("old") == [False] * len(files)
-    assert cache("new") == [True] * len(files)              # same sources: the cache stays
+    assert look("old") == [False] * len(files)
+    assert look("new") == [True] * len(files)              # same sources: the cache stays
     (package / "shapes" / "a.py").write_text("# a changed kernel\n")
-    assert cache("newer") == [False] * len(files)
+    assert look("newer") == [False] * len(files)
 
 
 def test_a_forecast_of_numbas_cache(tmp_path, monkeypatch):

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import os
 
-from rtcli import variants
 from rtcli.errors import RtcliError, one_line, shown
+from rtcli.kernels import variants
 from rtcli.scenefile.files import NUL
 from rtcli.scenefile.build import camera_form, check_image_size
 

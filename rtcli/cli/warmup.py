@@ -23,16 +23,16 @@ def warmup(cluster, cluster_file, local_cluster):
         from rtcli.cluster.warm import warm  # start-up: Dask only when asked
         with where:
             return warm(where.session(), click.echo)
-    from rtcli import variants  # start-up
+    from rtcli.kernels import numba_cache, variants  # start-up
     from rtcli.kernels import machinecode
     from rtcli.rendering.warmup import bytecode
     from rtcli.rendering.warmup import warmup as warm
     start = time.perf_counter()
     machinecode.report_to(lambda text: click.echo(f"note: {text}", err=True))
-    where = variants.cache_location() if variants.ENABLED else None
+    where = numba_cache.cache_location() if variants.ENABLED else None
     if where is not None:
         click.echo(f"cache: {where} ({where.why})" if where.enabled else f"cache: none ({where.why}); "
-                   f"set {variants.CACHE_ENV} to a writable folder")
+                   f"set {numba_cache.CACHE_ENV} to a writable folder")
     done, (files, why) = warm(notes=lambda text: click.echo(f"note: {text}", err=True))
     for what, load in done:
         how = f"compiled in {load.compile_seconds:.1f} s" if load.compile_seconds else "loaded from the cache"

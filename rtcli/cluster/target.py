@@ -52,7 +52,7 @@ def _checked_address(address: str, what: str) -> str:
 
 def load_distributed():
     try:
-        import distributed
+        import distributed  # the cluster extra, optional: loaded when a command asks for a cluster
     except ImportError:
         raise RtcliError(f"a cluster needs Dask's distributed scheduler, which is not installed: {INSTALL}") \
             from None
@@ -61,6 +61,6 @@ def load_distributed():
 
 def connect_timeout() -> float:
     """Dask's connect timeout (distributed.comm.timeouts.connect), in seconds."""
-    import dask
+    import dask  # the cluster extra, optional: loaded when a command asks for a cluster
     from dask.utils import parse_timedelta
     return parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), "s")

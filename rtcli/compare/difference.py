@@ -16,6 +16,7 @@ import numpy as np
 from rtcli.api.options import check_options, check_path
 from rtcli.api.results import ImageArray, png_bytes
 from rtcli.compare import images as gate
+from rtcli.core.display import to_8bit
 from rtcli.errors import RtcliError
 
 GATE = {"tolerance": 2, "max_bad_pixels": 16, "max_bad_fraction": 1e-4, "max_cluster": 3}
@@ -83,6 +84,5 @@ def pixels(image, name: str = "image") -> np.ndarray:
     if array.dtype.kind == "f":
         if array.ndim != 3 or array.shape[2] != 3:
             raise RtcliError(f"{name} is not an RGB image (H, W, 3): got {array.dtype} array of shape {array.shape}")
-        from rtcli.core.display import to_8bit
         return to_8bit(array)
     return array

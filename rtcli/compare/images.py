@@ -21,12 +21,15 @@ Every comparison yields a one-line summary starting with "OK:" or "FAIL:".
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from PIL import Image
 from scipy import ndimage
 
 from rtcli.errors import RtcliError, plural, shown
+from rtcli.scenefile.files import InputError, check_input
 
 _EIGHT = np.ones((3, 3), dtype=int)     # 8-connectivity for ndimage.label
 
@@ -217,11 +220,7 @@ def read_png(path) -> np.ndarray:
     a comparison holds both images (3 bytes per pixel each) and a few bytes per pixel
     more, about 500 MB at the limit with --diff.
     """
-    import warnings
 
-    from PIL import Image
-
-    from rtcli.scenefile.files import InputError, check_input
     try:
         check_input(path, 1 << 40)
         with warnings.catch_warnings():
@@ -254,7 +253,7 @@ def flip_map(actual: np.ndarray, expected: np.ndarray) -> tuple[np.ndarray, floa
     Needs the optional flip-evaluator package (`pip install -e '.[flip]'` in the rtcli folder).
     """
     try:
-        import flip_evaluator
+        import flip_evaluator  # the flip extra, optional: only for --metric flip
     except ImportError:
         raise RtcliError("--flip needs the flip-evaluator package: pip install -e '.[flip]' in the rtcli "
                          "folder (rtcli is not on the package index)") from None

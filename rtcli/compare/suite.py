@@ -14,14 +14,15 @@ import time
 from collections.abc import Callable
 
 from rtcli.compare.folders import compare_folders, images_under, total_line
+from rtcli.compare.junit import junit_xml, write_junit
+from rtcli.compare.report import Report, check_report_dir
 from rtcli.errors import RtcliError, shown
+from rtcli.rendering.outputs import check_file_output
 
 
 def compare_dirs(actual: str, expected: str, image_options: dict, id_options: dict, report: str | None,
                  junit: str | None, echo: Callable[[str], None]) -> bool:
     """Compare the folders, print the lines, write the outputs; whether every pair passed."""
-    from rtcli.compare.junit import junit_xml, write_junit
-    from rtcli.compare.report import Report
     _check_outputs(actual, expected, report, junit)
     start = time.perf_counter()
     built = Report(report, image_options["tolerance"], (actual, expected)) if report else None
@@ -59,8 +60,6 @@ def are_folders(actual: str, expected: str) -> bool:
 
 
 def _check_outputs(actual: str, expected: str, report: str | None, junit: str | None) -> None:
-    from rtcli.compare.report import check_report_dir
-    from rtcli.rendering.outputs import check_file_output
     inputs = list(images_under(actual).values()) + list(images_under(expected).values())
     if report:
         check_report_dir(report, [actual, expected])

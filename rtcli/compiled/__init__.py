@@ -3,7 +3,7 @@
 numpy's throughput on arrays bounds the wavefront engine (rtcli/wavefront/) at
 about 1.4 ns per element-operation, with dozens of operations per ray and bounce.
 This package runs the same integrator one ray at a time, compiled, on the same
-kernels (rtcli/variants.py), and gives the same pixels (tests/test_compiled.py
+kernels (rtcli/kernels/variants.py), and gives the same pixels (tests/test_compiled.py
 renders every supported scene both ways). Which engine renders a job is decided in one
 place, rtcli/rendering/engine.py, from what this package says: what it cannot render
 (pack.unsupported), why it cannot start (why_not), whether it starts at once or its code is
@@ -31,12 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rtcli import variants
+from rtcli.compiled.integrator import trace_camera
 from rtcli.compiled.loading import Load, cached, ready, say
 from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
-from rtcli.kernels import machinecode
+from rtcli.kernels import machinecode, numba_cache, variants
 from rtcli.stats import Stats
 
 __all__ = ["Compiled", "Load", "ready_to_load", "starts_at_once", "unsupported", "why_not"]
@@ -99,11 +99,10 @@ ENTRY = "trace_camera"
 
 
 def compiled_integrator():
-    from rtcli.compiled.integrator import trace_camera
     return variants.compiled(trace_camera)
 
 
-PACKAGE = Path(variants.PACKAGE_DIR)
+PACKAGE = Path(numba_cache.PACKAGE_DIR)
 STAMP = "rtcli-compiled.sha256"
 CACHED = ("*.nbi", "*.nbc", "rtcli-*.so", "rtcli-*.json")     # numba's files and the machine code files
 
@@ -112,13 +111,13 @@ def cache_places() -> list[tuple[list[Path], bool]]:
     """Every place numba may keep rtcli's machine code, as (its folders, the compiled one first;
     whether rtcli uses it now): beside the sources, RTCLI_CACHE_DIR, NUMBA_CACHE_DIR, rtcli's per-user
     cache, and numba's own per-user cache (where numba puts it for a read-only install by itself)."""
-    dirs = [PACKAGE / "compiled", PACKAGE / "core", PACKAGE / "shapes", PACKAGE]
-    where = variants.cache_location()
+    dirs = [PACKAGE / "compiled"] + [PACKAGE / d for d in numba_cache.COMPILED_DIRS if d != "compiled"]
+    where = numba_cache.cache_location()
     places = [([d / "__pycache__" for d in dirs], where.enabled and where.root is None)]
-    roots = [os.environ.get(variants.CACHE_ENV), os.environ.get("NUMBA_CACHE_DIR"), variants.user_cache_dir(),
+    roots = [os.environ.get(numba_cache.CACHE_ENV), os.environ.get("NUMBA_CACHE_DIR"), numba_cache.user_cache_dir(),
              _numba_user_cache()]
     for root in dict.fromkeys(os.path.abspath(os.path.expanduser(r)) for r in roots if r):
-        folders = [Path(root) / variants.numba_subfolder(str(d)) for d in dirs]
+        folders = [Path(root) / numba_cache.numba_subfolder(str(d)) for d in dirs]
         places.append((folders, where.enabled and where.root == root))
     return places
 
@@ -126,8 +125,8 @@ def cache_places() -> list[tuple[list[Path], bool]]:
 def _numba_user_cache() -> str:
     """numba's own per-user cache folder (its appdirs' user_cache_dir for "numba")."""
     if os.name == "nt":
-        return os.path.join(variants.user_cache_base(), "numba", "Cache")
-    return os.path.join(variants.user_cache_base(), "numba")
+        return os.path.join(numba_cache.user_cache_base(), "numba", "Cache")
+    return os.path.join(numba_cache.user_cache_base(), "numba")
 
 
 def drop_stale_cache() -> None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sys
 
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.core.bvh_build import levels, levels_build
 from rtcli.kernels import machinecode
 

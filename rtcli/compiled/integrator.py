@@ -48,7 +48,7 @@ from rtcli.core.textures import IMAGE, NONE, texture_color
 from rtcli.core.textures import KIND as TEXTURE_KIND
 from rtcli.core.transform import normal_to_world, ray_to_object
 from rtcli.core.vec import dot, reflect, refract, unit
-from rtcli.variants import per_ray
+from rtcli.kernels.variants import per_ray
 
 SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
 

@@ -1,7 +1,7 @@
 """The compiled functions' machine code made ready: loaded from numba's on-disk cache, or compiled.
 
 numba compiles a function the first time it is called, then keeps the machine code on disk
-(variants.cache_location() says where): a later process loads it in a fraction of a second,
+(numba_cache.cache_location() says where): a later process loads it in a fraction of a second,
 but the first one spends about a minute compiling the integrator. That minute is never
 silent: `ready` says on stderr that it compiles, where the code will be cached and, after,
 how long it took; and it returns the time apart (RenderStats.load_seconds, compile_seconds),
@@ -23,7 +23,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from rtcli import variants
+from rtcli.kernels import numba_cache
 
 
 @dataclass
@@ -71,7 +71,7 @@ def ready(entries: list, call: Callable[[], object], what: str, about: str,
     notes = notes or say
     start = time.perf_counter() if start is None else start
     todo = [d for d in entries if not d.signatures]          # in memory already: nothing to load
-    where = variants.cache_location()
+    where = numba_cache.cache_location()
     cold = bool(todo) and (not where.enabled or any(cached(d) is False for d in todo))
     if cold:
         notes(f"compiling {what}, once ({about}); " + (f"cached in {where}" if where.enabled else

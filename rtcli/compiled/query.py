@@ -49,7 +49,7 @@ from rtcli.core.transform import OBJECT, affine, normal_to_world, ray_to_object
 from rtcli.shapes import SHAPES
 from rtcli.shapes.csg import combine, nearest
 from rtcli.shapes.triangle import triangle_leaf
-from rtcli.variants import INF, compiled, per_ray, to_int
+from rtcli.kernels.variants import INF, compiled, per_ray, to_int
 
 
 # --- the dispatch on the shape's kind: one link per registered shape ---

@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from rtcli.core.bvh_build import build
-from rtcli.variants import INF, kernel, narrow, per_ray
+from rtcli.kernels.variants import INF, kernel, narrow, per_ray
 
 CHUNK = 1 << 13                         # rays traversed together by the numpy walk
 PAD = 1e-9                              # boxes grow by PAD x their largest |coordinate|, so rounding in

@@ -13,7 +13,7 @@ Two builds make the same tree, number for number (tests/test_bvh.py):
   are (3, m) rows, so that each gather, reduction and scatter runs over contiguous
   arrays, and a level's bins are [bin, ..., node] arrays whose running minima run over
   contiguous rows.
-- `levels`, per node and per primitive (python and compiled variants, rtcli/variants.py):
+- `levels`, per node and per primitive (python and compiled variants, rtcli/kernels/variants.py):
   the compiled one builds 100,000 triangles' tree in a few hundredths of a second.
 `build` runs `levels` when it is given a runner of it (the compiled variant, from its machine
 code file or numba: rtcli/compiled/build.py, which the engine choice, rendering/engine.py,
@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.variants import INF, per_ray
+from rtcli.kernels.variants import INF, per_ray
 
 
 def build(lo, hi, leaf_size, bins, levels=None):

@@ -14,7 +14,7 @@ import numpy as np
 
 from rtcli.core.elementary import cos, sin
 from rtcli.core.vec import cross3, length3, unit3
-from rtcli.variants import kernel
+from rtcli.kernels.variants import kernel
 
 EYE, ORIGIN, RIGHT, DOWN = 0, 3, 6, 9     # offsets of the vectors in Camera.row
 

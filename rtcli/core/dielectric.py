@@ -27,7 +27,7 @@ already sends the light to the mirror ray, so the setting does not apply.
 
 from __future__ import annotations
 
-from rtcli.variants import kernel, not_, select, sqrt
+from rtcli.kernels.variants import kernel, not_, select, sqrt
 
 FEELER_CROSSINGS = 64       # surfaces a filtered shadow feeler may cross; past them the light is stopped
 

@@ -2,7 +2,7 @@
 
 rtcli computes them itself, from IEEE arithmetic, sqrt, floor, frexp and ldexp alone:
 operations that every CPU and every library rounds the same way. The numpy and the scalar
-variants of each kernel (rtcli/variants.py) then give the same bits, and so do CPUs of
+variants of each kernel (rtcli/kernels/variants.py) then give the same bits, and so do CPUs of
 every kind. numpy's own power, arccos, arcsin, arctan2 and cbrt come from Intel's SVML on
 CPUs with AVX-512 and from the C library elsewhere, and the two differ in the last bit now
 and then: enough to tip a pixel from one 8-bit value to the next (docs/architecture.md,
@@ -24,7 +24,7 @@ from decimal import Decimal, localcontext
 
 import numpy as np
 
-from rtcli.variants import (
+from rtcli.kernels.variants import (
     INF,
     copysign,
     floor,

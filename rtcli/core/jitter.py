@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.variants import bits, kernel, u64
+from rtcli.kernels.variants import bits, kernel, u64
 
 GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 M1, M2 = np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB)

@@ -14,7 +14,7 @@ import numpy as np
 from rtcli.core.elementary import power
 from rtcli.core.jitter import hash_point
 from rtcli.core.vec import dot
-from rtcli.variants import kernel, maximum, select, sqrt
+from rtcli.kernels.variants import kernel, maximum, select, sqrt
 
 # The light row: position l, color I, attenuation [c0, c1, c2], spot? (1 or 0), the spot's unit
 # axis, cos of its half angle and falloff exponent, area samples n (0: a point), edges u and v.

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from rtcli.core.elementary import power
 from rtcli.core.vec import dot
-from rtcli.variants import kernel, maximum, select, sqrt
+from rtcli.kernels.variants import kernel, maximum, select, sqrt
 
 
 @kernel(inline=True)

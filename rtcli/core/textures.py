@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.variants import floor, kernel, maximum, minimum, select, to_int
+from rtcli.kernels.variants import floor, kernel, maximum, minimum, select, to_int
 
 NONE, CHECKER, IMAGE = 0, 1, 2                        # texture kinds
 KIND, INV_SIZE, COLOR1, COLOR2, FIRST, WIDTH, HEIGHT, REPEAT = 0, 1, 2, 5, 8, 9, 10, 11

@@ -19,7 +19,7 @@ import numpy as np
 
 from rtcli.core.elementary import cos, sin
 from rtcli.core.vec import cross3, dot3, length3, split, stack
-from rtcli.variants import kernel
+from rtcli.kernels.variants import kernel
 
 WORLD, OBJECT, NORMAL, PACKED = 0, 12, 24, 36        # offsets of the 3x4 matrices in Transform.packed
 

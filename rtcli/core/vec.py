@@ -1,7 +1,7 @@
 """Vectors as components (x, y, z): the few operations the notes use, written once.
 
 The kernels take and return components that are floats or (n,) arrays (see
-rtcli/variants.py). `dot3`, `cross3`, `unit3` and `length3` apply them to (..., 3)
+rtcli/kernels/variants.py). `dot3`, `cross3`, `unit3` and `length3` apply them to (..., 3)
 arrays, for setting up shapes and cameras.
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rtcli.variants import kernel, maximum, sqrt
+from rtcli.kernels.variants import kernel, maximum, sqrt
 
 
 @kernel

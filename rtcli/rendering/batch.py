@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.errors import RtcliError, SceneError, error_line, shown
-from rtcli.rendering.writer import FORMATS
+from rtcli.rendering.outputs import check_outputs
+from rtcli.rendering.writer import FORMATS, Staged
 
 SCENE_SUFFIXES = (".yaml", ".yml")
 
@@ -79,8 +80,6 @@ def run(items: list[Item], folder: str | None, load: Callable, render: Callable,
     folder made for them stays, even empty. An error about the outputs (one that is an input of
     a scene, or cannot be written) still stops the run with nothing placed.
     """
-    from rtcli.rendering.outputs import check_outputs
-    from rtcli.rendering.writer import Staged
     made = make_folder(folder)
     done, inputs, outputs = [], [], [(item.output, ids) for item in items]
     try:

@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import time
 
-from rtcli import compiled, variants, wavefront
+from rtcli import compiled, wavefront
+from rtcli.kernels import variants
 from rtcli.compiled import build as compiled_build
 from rtcli.errors import RtcliError
 

@@ -13,6 +13,7 @@ import os
 import stat
 
 from rtcli.errors import RtcliError, shown
+from rtcli.rendering.movie import movie_format
 from rtcli.rendering.writer import image_format
 from rtcli.scenefile.files import NUL, kind_of
 
@@ -27,7 +28,6 @@ def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> N
         _check_file(path, reals, known)
         real = os.path.realpath(path)
         if ids == "movie":
-            from rtcli.rendering.movie import movie_format
             movie_format(path)
         else:
             image_format(path, ids)

@@ -2,7 +2,7 @@
 
 A shape class holds its parameters (built from plain values: numbers, vectors,
 arrays) and says, as data, which YAML keys give them (`params`; the scene-file
-builder reads them). Its geometry is computed by kernels (rtcli/variants.py) that
+builder reads them). Its geometry is computed by kernels (rtcli/kernels/variants.py) that
 both engines call, over components in object space:
 
     hit(row, pool, ox, oy, oz, dx, dy, dz, t_min, t_max) -> (t, prim)

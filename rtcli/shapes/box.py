@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli.shapes.base import Param, ParamError, Shape, ShapeKernels
-from rtcli.variants import INF, kernel, not_, select
+from rtcli.kernels.variants import INF, kernel, not_, select
 
 LO, HI = 0, 3                                         # the row: min corner, max corner
 

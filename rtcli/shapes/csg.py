@@ -39,7 +39,7 @@ from rtcli.core.transform import (
     outer_bounds,
 )
 from rtcli.shapes.base import Shape
-from rtcli.variants import INF, kernel, per_ray, select
+from rtcli.kernels.variants import INF, kernel, per_ray, select
 
 OPS = ("union", "intersection", "difference")
 UNION, INTERSECTION, DIFFERENCE = range(3)           # OPS's codes (the compiled program's too)

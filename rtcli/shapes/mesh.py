@@ -35,7 +35,7 @@ from rtcli.shapes.triangle import (
     triangle_t,
     uv,
 )
-from rtcli.variants import INF, select
+from rtcli.kernels.variants import INF, select
 
 
 class Mesh(Shape):

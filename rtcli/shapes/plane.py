@@ -12,7 +12,7 @@ import numpy as np
 
 from rtcli.core.vec import cross3, dot, unit3
 from rtcli.shapes.base import Param, ParamError, Shape, ShapeKernels
-from rtcli.variants import INF, kernel, select
+from rtcli.kernels.variants import INF, kernel, select
 
 POINT, NORMAL, E1, E2 = 0, 3, 6, 9                    # the row: point, unit normal n, in-plane axes
 

@@ -15,7 +15,7 @@ import numpy as np
 from rtcli.core.vec import cross3, dot3, unit3
 from rtcli.shapes.base import POOL_WIDTH, Param, ParamError, Shape, ShapeKernels
 from rtcli.shapes.plane import NORMAL, POINT, in_plane_axes, normals, plane_t, uv
-from rtcli.variants import INF, kernel, select, to_int
+from rtcli.kernels.variants import INF, kernel, select, to_int
 
 # the row: a plane's (its first vertex, unit normal, in-plane (u, v) axes e1, e2: the plane's normals
 # and uv kernels serve), then the two axes of the projection, the vertex count and the first pool

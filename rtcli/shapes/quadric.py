@@ -30,7 +30,7 @@ import numpy as np
 from rtcli.core.elementary import arctan2
 from rtcli.core.vec import cross3, dot, unit3
 from rtcli.shapes.base import Param, ParamError, Shape, ShapeKernels
-from rtcli.variants import (
+from rtcli.kernels.variants import (
     INF,
     copysign,
     isfinite,

@@ -13,7 +13,7 @@ import numpy as np
 from rtcli.core.elementary import arcsin, arctan2
 from rtcli.core.vec import dot
 from rtcli.shapes.base import Param, Shape, ShapeKernels
-from rtcli.variants import (
+from rtcli.kernels.variants import (
     INF,
     copysign,
     isfinite,

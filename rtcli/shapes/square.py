@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli.shapes.base import Shape, ShapeKernels
-from rtcli.variants import INF, kernel, select
+from rtcli.kernels.variants import INF, kernel, select
 
 
 @kernel

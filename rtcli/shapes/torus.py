@@ -34,7 +34,7 @@ import numpy as np
 from rtcli.core.elementary import arccos, arctan2, cbrt, cos
 from rtcli.core.vec import dot
 from rtcli.shapes.base import Param, Shape, ShapeKernels
-from rtcli.variants import (
+from rtcli.kernels.variants import (
     INF,
     copysign,
     isfinite,

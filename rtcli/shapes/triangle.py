@@ -18,7 +18,7 @@ import numpy as np
 
 from rtcli.core.vec import cross, cross3, dot, length3, unit3
 from rtcli.shapes.base import POOL_WIDTH, Param, ParamError, Shape, ShapeKernels
-from rtcli.variants import INF, isnan, kernel, not_, per_ray, select, sqrt, to_int
+from rtcli.kernels.variants import INF, isnan, kernel, not_, per_ray, select, sqrt, to_int
 
 # a pool row: corner a, edges e1 and e2, face normal, corner normals na, nb, nc, corner (u, v)s
 A, E1, E2, FACE, NA, NB, NC, UVA, UVB, UVC = 0, 3, 6, 9, 12, 15, 18, 21, 23, 25

@@ -18,7 +18,7 @@ from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.scene import object_tree
 from rtcli.core.vec import unit
 from rtcli.shapes.sphere import Sphere
-from rtcli.variants import INF, select
+from rtcli.kernels.variants import INF, select
 from rtcli.wavefront.intersect import (
     blocked_by,
     blocks,

@@ -15,11 +15,11 @@ import platform
 import sys
 from pathlib import Path
 
-from rtcli import variants
+from rtcli.kernels import numba_cache
 
 ENABLED = os.environ.get("RTCLI_MACHINE_CODE", "1") != "0"
-SOURCES = ("variants.py", "core", "shapes", "compiled")     # what the machine code is made of
-PACKAGE = Path(variants.PACKAGE_DIR)
+SOURCES = numba_cache.COMPILED_DIRS      # what the machine code is made of: the folders numba compiles
+PACKAGE = Path(numba_cache.PACKAGE_DIR)
 HERE = Path(__file__).parent            # this package: any change to one of its files changes the key
 ENTRY_SYMBOL = "rtcli_entry"            # the C function rtcli calls, the one symbol a description may name
 
@@ -78,10 +78,10 @@ def _digest() -> str:
 
 
 def folder() -> Path | None:
-    """Where the files are: numba's cache folder of rtcli/compiled (variants.cache_location), or None
+    """Where the files are: numba's cache folder of rtcli/compiled (numba_cache.cache_location), or None
     when there is no cache."""
-    where = variants.cache_location()
-    return Path(where.folders()[variants.COMPILED_DIRS.index("compiled")]) if where.enabled else None
+    where = numba_cache.cache_location()
+    return Path(where.folders()[numba_cache.COMPILED_DIRS.index("compiled")]) if where.enabled else None
 
 
 def description_file(name: str, place: Path) -> Path:
