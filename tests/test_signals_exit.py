@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 
 import pytest
 
@@ -74,3 +75,42 @@ def test_sigterm_ends_a_starting_worker_without_a_word():
         print("survived")
     """)
     assert (done.returncode, done.stdout, done.stderr) == (-signal.SIGTERM, "", "")
+
+
+def test_while_a_pool_runs_only_the_first_signal_is_handled():
+    """interrupted_once: the handler that was there takes the first SIGINT or SIGTERM; a second,
+    of either kind, is ignored until the block ends, then the handlers are as they were."""
+    from rtcli.rendering.pool import interrupted_once
+    seen = []
+
+    def handler(signum, frame):
+        seen.append(signum)
+    before = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with interrupted_once():
+            os.kill(os.getpid(), signal.SIGINT)
+            os.kill(os.getpid(), signal.SIGTERM)
+            os.kill(os.getpid(), signal.SIGINT)
+        assert seen == [signal.SIGINT]
+        assert signal.getsignal(signal.SIGINT) is handler and signal.getsignal(signal.SIGTERM) is handler
+        os.kill(os.getpid(), signal.SIGTERM)
+        assert seen == [signal.SIGINT, signal.SIGTERM]
+    finally:
+        for s, h in before.items():
+            signal.signal(s, h)
+
+
+@pytest.mark.parametrize("gap", [0.0, 0.002, 0.02])
+def test_ctrl_c_then_sigterm_to_the_group_ends_with_one_line(tmp_path, gap):
+    """A Ctrl-C to the parent, then a supervisor's SIGTERM to the group while the first unwinds
+    (before: a traceback or a hang in about half the runs)."""
+    from test_signals import _nothing_left, _start, _stop
+    proc = _start(tmp_path, workers=2)
+
+    def send():
+        os.kill(proc.pid, signal.SIGINT)
+        time.sleep(gap)
+        os.killpg(proc.pid, signal.SIGTERM)
+    returncode, seconds, err = _stop(proc, send)
+    assert returncode in (130, 143) and err == "error: interrupted\n" and seconds < 10
+    _nothing_left(tmp_path, proc)

@@ -42,6 +42,34 @@ def held_signals():
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
+@contextlib.contextmanager
+def interrupted_once():
+    """While the block runs (a pool's life, its stop included), the first SIGINT or SIGTERM goes to
+    the handler that was there (the command line's raises Interrupted, Python's KeyboardInterrupt)
+    and any later one is ignored. A second signal (Ctrl-C, then a supervisor's SIGTERM) would
+    otherwise raise again while the first unwinds: half way through the release of a lock of
+    threading (`RuntimeError: release unlocked lock`), or through the pool's shutdown, with a
+    traceback or a hang. Stopping the pool is bounded (stop_pool), so ignoring is safe."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.getsignal(s) for s in HELD}
+    wrapped = {s: h for s, h in previous.items() if callable(h)}
+    fired: list[int] = []
+
+    def once(signum, frame):
+        if not fired:
+            fired.append(signum)
+            wrapped[signum](signum, frame)
+    for s in wrapped:
+        signal.signal(s, once)
+    try:
+        yield
+    finally:
+        for s, h in wrapped.items():
+            signal.signal(s, h)
+
+
 def watch_worker() -> None:
     """In a worker: ignore SIGINT (the parent handles it), take SIGTERM again (it was forked while
     the parent held it) and die when the parent dies. SIGTERM ends a worker at once, by its
