@@ -108,11 +108,11 @@ class ImageArray(np.ndarray):
         """The 8-bit image: linear colors clamped to [0, 1], optionally sRGB-encoded, rounded; an id
         map as its signature picture (a fixed color per id, as `rtcli signature` draws it); a
         debug view as its picture."""
+        check_options(gamma=gamma)
         if self.picture is not None:
             return ImageArray(self.picture, inputs=self.inputs)
         if self.is_ids:
             return ImageArray(signature_colors(np.asarray(self)), inputs=self.inputs)
-        check_options(gamma=gamma)
         if self.ndim != 3 or self.shape[2] != 3:
             raise RtcliError(f"not an image: an array of shape {self.shape}")
         if self.dtype == np.uint8:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 
-from rtcli.api.options import check_options, image_size
+from rtcli.api.options import RANGES, check_options, image_size
 from rtcli.api.pictures import render_scene, signature_scene
 from rtcli.api.results import png_bytes
 from rtcli.errors import SOURCES, RtcliError, one_line, shown
@@ -47,8 +47,8 @@ class Scene:
 
     def at(self, frame: int) -> Scene:
         """The scene of another frame, with the same overrides (itself for its own frame)."""
-        if frame is None:
-            raise RtcliError("frame must be an integer in 1..100000, got None")
+        if frame is None:                          # "not given" to check_options, but at() needs one
+            raise RtcliError("frame must be an integer in {}..{}, got None".format(*RANGES["frame"]))
         check_options(frame=frame)
         check_frame(self._animation, frame, self.source, "frame")
         if frame == self.frame:
