@@ -20,7 +20,7 @@ import os
 from collections.abc import Callable
 
 from rtcli.api.loading import load
-from rtcli.api.options import check_options, image_size
+from rtcli.api.options import check_options, described, image_size
 from rtcli.api.pictures import Progress, render_scene, signature_scene
 from rtcli.api.results import ImageArray
 from rtcli.api.scene import Scene, Source
@@ -42,7 +42,7 @@ def load_scene(source: Source, *, width: int | None = None, height: int | None =
     YAML text or a dict are relative to `folder` (default: the current folder). `frame` picks
     the frame of an animated scene (default 1; `scene.at(k)` gives another).
     """
-    check_options(width=width, height=height, samples=samples, max_depth=max_depth, frame=frame)
+    check_options(width=width, height=height, samples=samples, max_depth=max_depth, frame=frame, folder=folder)
     scene = load(source, None if folder is None else os.fspath(folder), frame)
     return scene.override(width=width, height=height, samples=samples, max_depth=max_depth)
 
@@ -97,8 +97,8 @@ def view(scene: Scene | Source, kind: str, *, width: int | None = None, height: 
     """The debug view `kind` (normal, depth, uv, albedo, bounces or ids; docs/debugging.md) of a
     Scene, or of what load_scene takes, at its size or the one given: an ImageArray of the view's
     data, which shows as its picture (rtcli/inspect/views.py)."""
-    if kind not in KINDS:
-        raise RtcliError(f"the view must be one of {', '.join(KINDS)}, got {kind!r}")
+    if not isinstance(kind, str) or kind not in KINDS:
+        raise RtcliError(f"the view must be one of {', '.join(KINDS)}, got {described(kind)}")
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if kind == "ids":
         return signature_scene(scene, width=width, height=height, workers=1)
@@ -114,7 +114,7 @@ def explain(scene: Scene | Source, x: int, y: int, *, width: int | None = None, 
             bvh: bool = True) -> Explanation:
     """The ray trees of pixel (x, y) (column from the left, row from the top) of a Scene, or of
     what load_scene takes; the size and settings as render takes them (docs/debugging.md)."""
-    check_options(width=width, height=height, samples=samples, max_depth=max_depth)
+    check_options(width=width, height=height, samples=samples, max_depth=max_depth, gamma=gamma, bvh=bvh)
     if not isinstance(scene, Scene):
         scene = load_scene(scene, width=width, height=height)
     w, h, _ = image_size(scene.model, width, height)

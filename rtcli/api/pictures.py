@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.api.layers import check_layers, layers_of, meta_of, needs_floats
-from rtcli.api.options import check_engine, check_options, image_size
+from rtcli.api.options import check_engine, check_options, described, image_size
 from rtcli.api.results import ImageArray, RenderStats
 from rtcli.errors import RtcliError, shown
 from rtcli.rendering.outputs import check_format_options, check_outputs
@@ -45,7 +45,7 @@ def render_scene(scene, *, width: int | None = None, height: int | None = None, 
     """
     check_options(width=width, height=height, samples=samples, max_depth=max_depth, engine=engine,
                   workers=workers, block_size=block_size, tile=tile, gamma=gamma, bvh=bvh, linear=linear,
-                  alpha=alpha, half=half)
+                  alpha=alpha, half=half, output=output, progress=progress, notes=notes)
     if linear and gamma:
         raise RtcliError("gamma encodes 8-bit images; a linear render is converted by image.to_8bit(gamma=True)")
     check_engine(engine)
@@ -77,7 +77,7 @@ def signature_scene(scene, *, width: int | None = None, height: int | None = Non
     """The scene signature (notes 000 11.4) as an ImageArray of uint16 (H, W): per pixel the id of
     the first object hit, 0 for the background. It shows as the color-coded picture;
     `output` writes the ids as `rtcli signature --ids` does (a 16-bit PNG)."""
-    check_options(width=width, height=height, block_size=block_size, workers=workers)
+    check_options(width=width, height=height, block_size=block_size, workers=workers, output=output)
     check_ids(scene)
     if output is not None:
         _check_output(os.fspath(output), scene, True)
@@ -103,9 +103,20 @@ class LegendRow:
 
 def legend(scene, ids: np.ndarray) -> list[LegendRow]:
     """The rows of `rtcli signature --legend`: the background (id 0), then every object."""
-    counts = np.bincount(np.asarray(ids).ravel(), minlength=len(scene.model.objects) + 1)
+    counts = np.bincount(_ids(ids, len(scene.model.objects)).ravel(), minlength=len(scene.model.objects) + 1)
     rows = [LegendRow(0, "(background)", "-", int(counts[0]))]
     return rows + [LegendRow(o.id, o.name, o.kind, int(counts[o.id])) for o in scene.model.objects]
+
+
+def _ids(ids, objects: int) -> np.ndarray:
+    """`ids` as an array of the scene's ids (0 .. objects); RtcliError otherwise."""
+    array = np.asarray(ids) if isinstance(ids, np.ndarray) or isinstance(ids, (list, tuple)) else None
+    if array is None or array.dtype.kind not in "iub":
+        raise RtcliError(f"ids must be an array of object ids (rtcli.signature's), got {described(ids)}")
+    if array.size and not 0 <= array.min() <= array.max() <= objects:
+        raise RtcliError(f"ids holds {array.min() if array.min() < 0 else array.max()}, not an id of this scene "
+                         f"(0 for the background, 1..{objects} its objects)")
+    return array.astype(np.int64)
 
 
 def check_ids(scene) -> None:

@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from PIL import Image
 
+from rtcli.api.options import check_options, check_path
 from rtcli.core.display import signature_colors, to_8bit, to_8bit_alpha, to_16bit
 from rtcli.errors import RtcliError, shown
 from rtcli.rendering.outputs import check_format_options, check_outputs
@@ -119,12 +120,13 @@ class ImageArray(np.ndarray):
         """The 8-bit image: linear colors clamped to [0, 1], optionally sRGB-encoded, rounded; an id
         map as its signature picture (a fixed color per id, as `rtcli signature` draws it); a
         debug view as its picture."""
+        check_options(gamma=gamma)
         if self.picture is not None:
             return ImageArray(self.picture, inputs=self.inputs)
         if self.is_ids:
             return ImageArray(signature_colors(np.asarray(self)), inputs=self.inputs)
         if self.ndim != 3 or self.shape[2] not in (3, 4):
-            raise ValueError(f"not an image: an array of shape {self.shape}")
+            raise RtcliError(f"not an image: an array of shape {self.shape}")
         if self.dtype == np.uint8:
             return self
         convert = to_8bit_alpha if self.shape[2] == 4 else to_8bit
@@ -140,7 +142,7 @@ class ImageArray(np.ndarray):
         folder or a device is refused (RtcliError). Linear colors go to .exr and .pfm as floats
         (EXR: float16 with `half`, and the layers), with bit_depth=16 to a 16-bit PNG or TIFF,
         else to 8 bits; `gamma` sRGB-encodes linear colors on their way to 8 or 16 bits."""
-        path = str(path)
+        path = check_path("path", path)
         check_outputs([(path, self.is_ids)], list(self.inputs))
         with Staged() as staged:
             self.stage(staged, path, bit_depth=bit_depth, half=half, gamma=gamma)

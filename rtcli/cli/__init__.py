@@ -26,7 +26,7 @@ from rtcli.cli.render import render
 from rtcli.cli.signature import signature
 from rtcli.cli.validate import presets, validate
 from rtcli.cli.warmup import warmup
-from rtcli.errors import Interrupted, RtcliError, error_line, one_line
+from rtcli.errors import Interrupted, RtcliError, error_line, one_line, shown
 
 
 def _on_signal(signum, frame):
@@ -45,6 +45,9 @@ class RtcliGroup(click.Group):
         extra.pop("standalone_mode", None)
         if not args:
             args = ["--help"]
+        if (why := _nul_argument(args)) is not None:
+            click.echo(f"error: {why}", err=True)
+            sys.exit(2)
         restore = _catch_signals()
         try:
             code = super().main(args, prog_name or "rtcli", standalone_mode=False, **extra)
@@ -72,6 +75,19 @@ class RtcliGroup(click.Group):
             return super().invoke(ctx)
         except KeyboardInterrupt:
             raise Interrupted(signal.SIGINT) from None
+
+
+def _nul_argument(args: list[str]) -> str | None:
+    """The message for the first argument holding a NUL byte, named by its option (no path, and
+    no other value rtcli takes, holds one; a shell cannot pass one, a program can), or None."""
+    for k, arg in enumerate(args):
+        if "\0" in arg:
+            option, _, value = arg.partition("=") if arg.startswith("--") and "=" in arg else ("", "", arg)
+            if not option and k and args[k - 1].startswith("-") and not arg.startswith("-"):
+                option = args[k - 1]
+            named = f"{shown(option)} " if option and "\0" not in option else ""
+            return f"{named}{shown(value)}: an argument cannot hold a NUL byte (a path cannot)"
+    return None
 
 
 def _catch_signals():

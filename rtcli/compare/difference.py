@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rtcli.api.options import check_options, check_path
 from rtcli.api.results import ImageArray, png_bytes
 from rtcli.compare import images as gate
 from rtcli.core.display import to_8bit
@@ -60,6 +61,7 @@ def diff(actual, expected, *, flip: bool = False, **options) -> Difference:
     unknown = set(options) - set(GATE) - set(ID_GATE)
     if unknown:
         raise TypeError(f"diff() got unknown options: {', '.join(sorted(unknown))}")
+    check_options(flip=flip, **options)
     a, e = pixels(actual, "actual"), pixels(expected, "expected")
     image_options = {k: options.get(k, v) for k, v in GATE.items()}
     id_options = {k: options.get(k, v) for k, v in ID_GATE.items()}
@@ -75,7 +77,7 @@ def diff(actual, expected, *, flip: bool = False, **options) -> Difference:
 def pixels(image, name: str = "image") -> np.ndarray:
     """An image as compare.py takes it: uint8 (H, W, 3) or an integer (H, W) id map."""
     if isinstance(image, (str, os.PathLike)):
-        return gate.read_png(os.fspath(image))
+        return gate.read_png(check_path(name, image))
     if hasattr(image, "mode") and hasattr(image, "size"):           # a Pillow image
         return np.asarray(image if image.mode in ("RGB", "L", "I", "I;16") else image.convert("RGB"))
     array = np.asarray(image)

@@ -90,7 +90,7 @@ class Report:
     def finish(self, pairs: list[Pair], gate_text: str) -> None:
         rows = sorted(pairs, key=Pair.severity)
         text = page(rows, self.pictures, self.titles, gate_text, self.flip)
-        with open(os.path.join(self.tmp, "index.html"), "w", encoding="utf-8") as f:
+        with open(os.path.join(self.tmp, "index.html"), "w", encoding="utf-8", errors="backslashreplace") as f:
             f.write(text)
         open(os.path.join(self.tmp, MARKER), "w").close()
 

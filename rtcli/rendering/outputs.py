@@ -16,7 +16,7 @@ from rtcli.errors import RtcliError, shown
 from rtcli.rendering.exr import LAYERS
 from rtcli.rendering.movie import movie_format
 from rtcli.rendering.writer import ALPHA, DEEP, FLOATS, image_format
-from rtcli.scenefile.files import kind_of
+from rtcli.scenefile.files import NUL, kind_of
 
 
 def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> None:
@@ -26,8 +26,8 @@ def check_outputs(outputs: list[tuple[str, bool | str]], inputs: list[str]) -> N
     known = {_identity(p) for p in inputs} - {None}
     reals = {os.path.realpath(p) for p in inputs}
     for path, ids in outputs:
-        real = os.path.realpath(path)
         _check_file(path, reals, known)
+        real = os.path.realpath(path)
         if ids == "movie":
             movie_format(path)
         else:
@@ -64,6 +64,8 @@ def check_file_output(path: str, inputs: list[str]) -> None:
 
 
 def _check_file(path: str, reals: set, known: set) -> None:
+    if "\0" in path:
+        raise RtcliError(f"{shown(path)}: {NUL}")
     if os.path.realpath(path) in reals or _identity(path) in known:
         raise RtcliError(f"{shown(path)}: is an input of this run; it will not be overwritten "
                          "(choose another output name)")

@@ -24,7 +24,7 @@ from rtcli.core.display import to_8bit, to_8bit_alpha
 from rtcli.core.jitter import sample_positions
 from rtcli.core.scene import Scene
 from rtcli.rendering import engine as engines
-from rtcli.rendering.pool import held_signals, stop_pool, watch_worker, worker_died
+from rtcli.rendering.pool import held_signals, interrupted_once, stop_pool, watch_worker, worker_died
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import camera_rays
@@ -188,13 +188,14 @@ def _map_tiles(scene: Scene, engine, job: Job, tiles: list, workers: int):
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(scene, engine))
     finished = False
-    try:
-        with held_signals():                    # an interrupt inside submit() could hang the exit
-            futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
-        for f in as_completed(futures):
-            yield f.result()
-        finished = True
-    except BrokenProcessPool:
-        raise worker_died(pool) from None
-    finally:
-        stop_pool(pool, finished)
+    with interrupted_once():                    # a second signal would break the unwinding of the first
+        try:
+            with held_signals():                # an interrupt inside submit() could hang the exit
+                futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
+            for f in as_completed(futures):
+                yield f.result()
+            finished = True
+        except BrokenProcessPool:
+            raise worker_died(pool) from None
+        finally:
+            stop_pool(pool, finished)

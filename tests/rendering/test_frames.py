@@ -122,8 +122,8 @@ def test_validate_says_its_warnings_are_about_frame_1(run, tmp_path):
     (["--frames", "1-2", "--frame", "2", "-o", "f%d.png"], "--frames and --frame: give one"),
     (["--frames", "1-2", "-o", "f.png"], "-o f.png: 2 frames need a name with the frame number (frame_%04d.png) "
                                          "or a movie (.apng, .gif)"),
-    (["-o", "f%d%s.png"], "-o f%d%s.png: a frame pattern has one %d (or %04d ...) for the frame number, "
-                          "and %% for a percent sign"),
+    (["-o", "f%d%s.png"], "-o f%d%s.png: a frame pattern has one %d (or %04d ..., a width below 100) for the "
+                          "frame number, and %% for a percent sign"),
     (["-o", "f.png", "--movie", "m.mp4"], "m.mp4: an animation is written as an animated PNG or GIF: '.mp4' is "
                                           "not one of .apng, .gif"),
     (["-o", "orbit.yaml", "--frame", "2"], "orbit.yaml: is an input of this run; it will not be overwritten "
