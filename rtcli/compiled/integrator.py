@@ -38,7 +38,7 @@ from rtcli.compiled.pack import (
     N,
     P,
 )
-from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, material_of, scene_hit
+from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, leaf_point, material_of, scene_hit
 from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.camera import primary_ray
 from rtcli.core.dielectric import FEELER_CROSSINGS, fresnel, indices, refracted_media, split
@@ -75,13 +75,16 @@ def surface(g, k, prim, t, ox, oy, oz, dx, dy, dz):
 
 @per_ray(inline=True)
 def texture_at(g, s, m, k, prim, px, py, pz):
-    """T at the object-space point: the shape's (u, v) are worked out for image textures only."""
+    """T at the object-space point (a csg's: its leaf's own space): the shape's (u, v) are worked out
+    for image textures only."""
     tex = s.texture[m]
     if tex[TEXTURE_KIND] == NONE:
         return 1.0, 1.0, 1.0
     u, v = 0.0, 0.0
-    if tex[TEXTURE_KIND] == IMAGE and g.ints[k, KIND] == CSG_KIND:
-        u, v = csg_uv(g, prim, px, py, pz)
+    if g.ints[k, KIND] == CSG_KIND:
+        if tex[TEXTURE_KIND] == IMAGE:
+            u, v = csg_uv(g, prim, px, py, pz)
+        px, py, pz = leaf_point(g, prim % len(g.leaves), px, py, pz)     # as CSG.texture_points
     elif tex[TEXTURE_KIND] == IMAGE:
         u, v = UV_ANY(g.ints[k, KIND], g.objects[k], g.pool, prim, px, py, pz)
     return texture_color(tex, s.texels, px, py, pz, u, v)

@@ -217,7 +217,8 @@ def _object_surface(scene, obj, rays, hits, rows, normal, geometric, material, t
         ns, ng = normal_to_world(obj.transform, 0, *ns), normal_to_world(obj.transform, 0, *ng)
     with np.errstate(invalid="ignore", divide="ignore"):
         normal[:, rows], geometric[:, rows], material[rows] = unit(*ns), unit(*ng), mat
-    fill_texture(scene, p_obj, lambda sel: obj.shape.uv_at(p_obj[:, sel], prim[sel]), mat, texture, rows)
+    fill_texture(scene, obj.shape.texture_points(p_obj, prim), lambda sel: obj.shape.uv_at(p_obj[:, sel], prim[sel]),
+                 mat, texture, rows)
 
 
 def uv_at_hits(scene: Scene, rays: Rays, hits: Hits) -> np.ndarray:
