@@ -109,6 +109,7 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
         settings.epsilon = r.number("epsilon", 1e-6, positive=True)
         settings.medium_ior = r.number("medium_ior", 1.0, positive=True)
         settings.total_internal_reflection = r.choice("total_internal_reflection", ("drop", "reflect"), "drop")
+        settings.shadow_terminator = r.choice("shadow_terminator", ("none", "offset"), "none")
         r.check_unused()
     camera, eye = camera_from(p.sub("camera"))
     check_resolvable(p, camera, settings.width, settings.height)
