@@ -67,8 +67,9 @@ def test_the_engines_agree(yaml_scene, ball, mode):
 
 
 def test_the_engines_agree_on_smooth_triangles(yaml_scene):
-    """Smooth triangles (a tent under a grazing light, turned and stretched) in a group: the
-    offset's shift taken to world space the same way in both engines, and it changes the picture."""
+    """Smooth triangles (a tent, counter-clockwise from outside, under a grazing light, turned and
+    stretched) in a group: the offset's shift taken to world space the same way in both engines,
+    and it changes the picture."""
     text = """
         camera: {eye: [0, 1.5, -4], look_at: [0, 0.3, 0], fov: 45}
         ambient: [1, 1, 1]
@@ -79,10 +80,10 @@ def test_the_engines_agree_on_smooth_triangles(yaml_scene):
             material: {ambient: 0.05, diffuse: 0.9}
             group:
               objects:
-                - {triangle: {vertices: [[-1, 0, -1], [0, 1, -1], [0, 1, 1]], normals: [[-1, 0, 0], [0, 1, 0], [0, 1, 0]]}}
-                - {triangle: {vertices: [[-1, 0, -1], [0, 1, 1], [-1, 0, 1]], normals: [[-1, 0, 0], [0, 1, 0], [-1, 0, 0]]}}
-                - {triangle: {vertices: [[0, 1, -1], [1, 0, -1], [1, 0, 1]], normals: [[0, 1, 0], [1, 0, 0], [1, 0, 0]]}}
-                - {triangle: {vertices: [[0, 1, -1], [1, 0, 1], [0, 1, 1]], normals: [[0, 1, 0], [1, 0, 0], [0, 1, 0]]}}
+                - {triangle: {vertices: [[0, 1, 1], [0, 1, -1], [-1, 0, -1]], normals: [[0, 1, 0], [0, 1, 0], [-1, 0, 0]]}}
+                - {triangle: {vertices: [[-1, 0, 1], [0, 1, 1], [-1, 0, -1]], normals: [[-1, 0, 0], [0, 1, 0], [-1, 0, 0]]}}
+                - {triangle: {vertices: [[1, 0, 1], [1, 0, -1], [0, 1, -1]], normals: [[1, 0, 0], [1, 0, 0], [0, 1, 0]]}}
+                - {triangle: {vertices: [[0, 1, 1], [1, 0, 1], [0, 1, -1]], normals: [[0, 1, 0], [1, 0, 0], [0, 1, 0]]}}
     """
     images = {}
     for mode in ("none", "offset"):
