@@ -4,11 +4,15 @@ shades as smoothly as one that casts no shadow; `none` (the default) keeps the n
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
+from PIL import Image
 
 from rtcli.errors import SceneError
 from rtcli.rendering.tiles import Job, render
+from rtcli.scenefile.load import load_scene
 from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.triangle import Triangle, terminator
 
@@ -124,3 +128,18 @@ def test_no_shift_where_the_point_lies_above_every_corners_plane():
 def test_an_unknown_mode_is_an_error(yaml_scene, ball):
     with pytest.raises(SceneError, match="shadow_terminator"):
         yaml_scene(scene_text("pov"))
+
+
+def test_the_documents_picture_is_the_example_rendered():
+    """docs/images/shadow-terminator.png is docs/examples/terminator.yaml as written (left) and
+    with shadow_terminator: offset (right)."""
+    root = Path(__file__).resolve().parent.parent
+    picture = np.asarray(Image.open(root / "docs" / "images" / "shadow-terminator.png").convert("RGB"))
+    scene = load_scene(str(root / "docs" / "examples" / "terminator.yaml"))
+    assert scene.settings.shadow_terminator == "none"
+    w, h = scene.settings.width, scene.settings.height
+    left = render(scene, Job(w, h, engine="numpy"))[0]
+    scene.settings.shadow_terminator = "offset"
+    right = render(scene, Job(w, h, engine="numpy"))[0]
+    np.testing.assert_array_equal(picture[:h, :w], left)
+    np.testing.assert_array_equal(picture[:h, w + 4:2 * w + 4], right)
