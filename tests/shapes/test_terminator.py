@@ -133,7 +133,7 @@ def test_an_unknown_mode_is_an_error(yaml_scene, ball):
 def test_the_documents_picture_is_the_example_rendered():
     """docs/images/shadow-terminator.png is docs/examples/terminator.yaml as written (left) and
     with shadow_terminator: offset (right)."""
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     picture = np.asarray(Image.open(root / "docs" / "images" / "shadow-terminator.png").convert("RGB"))
     scene = load_scene(str(root / "docs" / "examples" / "terminator.yaml"))
     assert scene.settings.shadow_terminator == "none"

@@ -27,7 +27,7 @@ from rtcli.scenefile.load import load_scene
 from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.triangle import E1, E2, NA, UVA, A
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data" / "povray" / "features"
 W, H = 160, 120
 TOLERANCE, EDGE = 8, 24
