@@ -50,6 +50,7 @@ SHAPE_WIDTH = 20                                   # columns of an object row: t
 KIND, XFORM, CASTS, MATERIAL = range(4)            # columns of ints
 KINDS = {cls: k for k, cls in enumerate(SHAPES.values())}
 CSG_KIND = len(KINDS)
+SMOOTH_KINDS = (KINDS[SHAPES["triangle"]], KINDS[SHAPES["mesh"]])     # shapes with a shadow-terminator shift
 # A csg's row: where its program starts and how long it is, its leaf count, how many spans its
 # leaves can give (SPANS: the capacity of its span lists), its largest number of children, its
 # scratch (in the traversal stack), and its object-space box (BOUNDED 0: none).
@@ -70,7 +71,7 @@ ROW, DEPTH, PATH = 1, 2, 4                         # columns of leaves (KIND and
 Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool program leaves")
 Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear fresnel filters texture "
                             "texels lights samples ambient background offset max_depth blinn medium_ior "
-                            "reflect_tir any_filter")
+                            "reflect_tir any_filter terminator")
 
 
 def unsupported(scene) -> str | None:
@@ -232,7 +233,7 @@ def looks(scene) -> Looks:
                  samples, np.asarray(scene.ambient, float), np.asarray(scene.background, float),
                  float(scene.offset), int(scene.settings.max_depth), scene.settings.specular == "blinn",
                  float(scene.settings.medium_ior), scene.settings.total_internal_reflection == "reflect",
-                 bool(table.filters.any()))
+                 bool(table.filters.any()), scene.settings.shadow_terminator == "offset")
 
 
 def frames(max_depth: int) -> np.ndarray:

@@ -75,6 +75,7 @@ class Settings:
     medium_ior: float = 1.0          # index of refraction around every object (the camera's medium)
     total_internal_reflection: str = "drop"   # drop: the refracted weight is lost; reflect: to the mirror ray
     alpha: bool = False              # the background transparent, in the images that have alpha
+    shadow_terminator: str = "none"  # none: feelers leave from the hit; offset: Hanika's shift on smooth faces
 
     @contextlib.contextmanager
     def overridden(self, samples: int | None, max_depth: int | None):

@@ -110,6 +110,7 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
         settings.medium_ior = r.number("medium_ior", 1.0, positive=True)
         settings.total_internal_reflection = r.choice("total_internal_reflection", ("drop", "reflect"), "drop")
         settings.alpha = r.boolean("alpha", False)
+        settings.shadow_terminator = r.choice("shadow_terminator", ("none", "offset"), "none")
         r.check_unused()
     camera, eye = camera_from(p.sub("camera"))
     check_resolvable(p, camera, settings.width, settings.height)

@@ -5,7 +5,8 @@ POV-Ray renders the .pov afresh when it is installed (`apt-get install povray`);
 stored image stands in. The two must agree away from silhouettes (pixels next to another
 object in rtcli's signature are left out: sampling differs there): a mean difference under 2/255
 and under 1% of pixels off by more than 25/255. Each pair also renders with the option turned
-to something POV-Ray does not do, to show the comparison can tell.
+to something POV-Ray does not do, to show the comparison can tell. The other features (meshes,
+csg, lights, textures, quadrics) are compared in test_povray_features.py.
 """
 
 from __future__ import annotations
