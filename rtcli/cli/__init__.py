@@ -54,6 +54,7 @@ class RtcliGroup(click.Group):
         except click.exceptions.Exit as e:
             sys.exit(e.exit_code)
         except (Interrupted, click.exceptions.Abort) as e:
+            restore = _ignore_signals()                # the first signal decides; the exit is bounded
             if sys.stderr.isatty():
                 click.echo(err=True)                   # end the line the terminal's ^C is on
             click.echo("error: interrupted", err=True)
@@ -88,6 +89,16 @@ def _nul_argument(args: list[str]) -> str | None:
             named = f"{shown(option)} " if option and "\0" not in option else ""
             return f"{named}{shown(value)}: an argument cannot hold a NUL byte (a path cannot)"
     return None
+
+
+def _ignore_signals():
+    """Ignore SIGINT and SIGTERM from now on (a process on its way out after the first: a later
+    one, a supervisor's SIGTERM to the group, would otherwise kill it by the default action half
+    way through its exit); returns the undo, which does nothing."""
+    if threading.current_thread() is threading.main_thread():
+        for s in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(s, signal.SIG_IGN)
+    return lambda: None
 
 
 def _catch_signals():
