@@ -40,11 +40,13 @@ from collections import namedtuple
 import numpy as np
 
 from rtcli.core.bvh import BVH, padded
+from rtcli.core.objects import singles, sphere_blocks
 from rtcli.core.scene import object_tree
 from rtcli.core.transform import PACKED
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import POOL_WIDTH
 from rtcli.shapes.csg import CSG, OPS
+from rtcli.shapes.sphere import Sphere
 
 SHAPE_WIDTH = 20                                   # columns of an object row: the widest shape's row
 KIND, XFORM, CASTS, MATERIAL = range(4)            # columns of ints
@@ -75,7 +77,7 @@ Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror 
 
 def unsupported(scene) -> str | None:
     """Why the compiled engine cannot render `scene`, or None when it can."""
-    for o in scene.objects:
+    for _, o in singles(scene.objects):                 # a block's spheres are supported
         if type(o.shape) not in KINDS and not isinstance(o.shape, CSG):
             return f"{o.kind or type(o.shape).__name__} objects"
     return None
@@ -192,7 +194,12 @@ def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int
             n_pool += len(shape.pool)
         return row
 
-    for k, o in enumerate(scene.objects):
+    for start, block in sphere_blocks(scene.objects):          # spheres kept as arrays (core/objects.py)
+        end = start + len(block)
+        objects[start:end, :block.rows.shape[1]] = block.rows
+        ints[start:end] = np.stack([np.full(len(block), KINDS[Sphere]), np.full(len(block), -1),
+                                    scene.materials.shadow[block.material], block.material], axis=1)
+    for k, o in singles(scene.objects):
         shape = o.shape
         if isinstance(shape, CSG):
             objects[k], kind = csgs.add(shape, transforms), CSG_KIND

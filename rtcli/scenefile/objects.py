@@ -11,17 +11,22 @@ from __future__ import annotations
 
 import os
 
+import numpy as np
+
 from rtcli.core import transform as tf
-from rtcli.core.scene import SceneObject
-from rtcli.errors import SceneError, shown
+from rtcli.core.objects import ObjectList, SceneObject, SphereBlock
+from rtcli.errors import SceneError, Where, shown
 from rtcli.scenefile import params as required
 from rtcli.scenefile import reuse
 from rtcli.scenefile.guards import bounded, check_count
+from rtcli.scenefile.limits import MAX_MAGNITUDE, MAX_OBJECTS
 from rtcli.scenefile.materials import material_ref
 from rtcli.scenefile.named_files import read_mesh_file
 from rtcli.scenefile.nodes import MapNode
 from rtcli.scenefile.params import Params, as_params
 from rtcli.scenefile.transforms import compose, transform_from
+from rtcli.scenefile.yamlbulk import SphereRun
+from rtcli.scenefile.yamlevents import Builder, Loader
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import REQUIRED, ParamError
 from rtcli.shapes.csg import CSG, OPS, Child
@@ -85,13 +90,38 @@ class ObjectBuilder:
 
     def __init__(self, named: dict, table: list, default_material: int):
         self.named, self.table, self.default = named, table, default_material
-        self.objects: list[SceneObject] = []
+        self.objects = ObjectList()
 
     def add_all(self, items, parent: tf.Transform | None = None, material: int | None = None):
         for item, where, path in items:
+            if type(item) is SphereRun:
+                self.add_run(item, where, path, self.default if material is None else material)
+                continue
             check_count(self.objects, where, path)
             self.add(as_params(item, where, path, "an object (a mapping with a shape key)"), parent,
                      self.default if material is None else material)
+
+    def add_run(self, run: SphereRun, where, path: str, material: int) -> None:
+        """A run of spheres read in bulk (yamlbulk.py; `path`: its first's), checked in bulk as
+        add() checks each: the first that fails is read again the usual way, for its error."""
+        prefix, first = path[:path.rindex("[")], int(path[path.rindex("[") + 1:-1])
+        c, r = run.centers, run.radii
+        bad = ~(np.abs(c) <= MAX_MAGNITUDE).all(axis=1) | ~((r > 0) & (r <= MAX_MAGNITUDE))
+        worst = int(np.argmax(bad)) if bad.any() else len(run)
+        room = MAX_OBJECTS - len(self.objects)
+        if room < len(run) and room <= worst:
+            check_count(range(MAX_OBJECTS), Where(where.file, int(run.lines[room]), run.column),
+                        f"{prefix}[{first + room}]")
+        if worst < len(run):
+            self._line_again(run, worst, where.file, f"{prefix}[{first + worst}]", material)
+        self.objects.add_block(SphereBlock(c, r, material, where.file, run.lines, run.column, prefix, first))
+
+    def _line_again(self, run: SphereRun, j: int, file: str, path: str, material: int) -> None:
+        """Read sphere j of the run the usual way, which raises the error the bulk check found."""
+        text = "\n" * (int(run.lines[j]) - 1) + run.line(j)
+        seq = Builder(Loader(text), file, ".", text).document()
+        self.add(as_params(seq[0], seq.item_where[0], path, "an object (a mapping with a shape key)"), None, material)
+        raise SceneError(seq.item_where[0], path, "this sphere cannot be read")       # not reached: add() raised
 
     def add(self, p: Params, parent, inherited: int) -> None:
         kind = self._kind(p)
