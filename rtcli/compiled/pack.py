@@ -165,14 +165,15 @@ class _Trees:
                 np.concatenate(self.perm).astype(np.int64))
 
 
-def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int]:
+def geometry(scene, tree: bool, bvh: tuple | None = None, levels=None) -> tuple[Geometry, int]:
     """The scene's geometry, and the traversal stack it needs (the scene's tree, then a mesh's).
-    Without `tree` every object is listed, in file order; `bvh`: object_tree's, if made already."""
+    Without `tree` every object is listed, in file order; `bvh`: object_tree's, if made already;
+    `levels`: the compiled tree build (core/bvh_build.py; the same tree as numpy's, sooner)."""
     n = len(scene.objects)
     objects, ints = np.zeros((n, SHAPE_WIDTH)), np.zeros((n, 4), dtype=np.int64)
     bounded = scene.boxes.bounded
     listed = np.flatnonzero(~bounded | (not tree))
-    members, scene_bvh = (bvh or object_tree(scene)) if tree else (np.zeros(0, np.int64), BVH(np.zeros((0, 3)),
+    members, scene_bvh = (bvh or object_tree(scene, levels)) if tree else (np.zeros(0, np.int64), BVH(np.zeros((0, 3)),
                                                                                              np.zeros((0, 3))))
     trees, mesh_depth, transforms, csgs, csg_scratch = _Trees(), 0, [], _CSGs(n), 0
     trees.add(scene_bvh, members)                    # root 0
