@@ -122,3 +122,12 @@ def test_a_syntax_error_after_a_run_is_the_usual_one(tmp_path, monkeypatch):
     message = error_of(path, monkeypatch)
     assert message == error_of(path, monkeypatch, usual=True)
     assert "invalid YAML" in message
+
+
+def test_a_run_read_in_chunks_is_the_same(tmp_path, monkeypatch):
+    monkeypatch.setattr(yamlbulk, "CHUNK", 16)
+    lines = spheres(150)
+    lines[70] = "  - {sphere: {center: [1, 2, 3], radius: 1e0}}"          # not plain: the usual way
+    bulk, usual = both(write(tmp_path, HEAD + "\n".join(lines) + "\n"), monkeypatch)
+    assert [(s, len(b)) for s, b in sphere_blocks(bulk.objects)] == [(0, 70), (71, 79)]
+    same_objects(bulk, usual)

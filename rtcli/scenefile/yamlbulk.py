@@ -28,6 +28,7 @@ _SKELETON = b"{sphere: {center: [, , ], radius: }}"     # a line without its num
 _NUMBER_CHARS = b"0123456789.-"
 _TOKEN = "__rtcli_sphere_run_"
 _INDENTS = 16                           # indentations of runs looked for, the least first
+CHUNK = 65536                           # lines read at once
 _TRIES = 8                              # rounds of taking lines that are not plain out of runs
 
 
@@ -61,7 +62,7 @@ def extract(text: str) -> tuple[str, list[SphereRun]]:
     starts = np.concatenate(([0], np.flatnonzero(np.frombuffer(data, np.uint8) == 10) + 1, [len(data) + 1]))
     indent = _indents(data, starts)
     for _ in range(_TRIES):
-        read = [(first, count, _numbers(data, starts, first, count, int(indent[first])))
+        read = [(first, count, _chunked(data, starts, first, count, int(indent[first])))
                 for first, count in _runs(indent)]
         bad = [first + j for first, _, (_, _, wrong) in read for j in wrong]
         if not bad:
@@ -100,6 +101,15 @@ def _runs(indent: np.ndarray) -> list[tuple[int, int]]:
     change = np.flatnonzero(np.diff(indent) != 0) + 1
     bounds = np.concatenate(([0], change, [len(indent)]))
     return [(int(a), int(b - a)) for a, b in zip(bounds[:-1], bounds[1:]) if indent[a] >= 0 and b - a >= RUN_MIN]
+
+
+def _chunked(data: bytes, starts: np.ndarray, first: int, count: int, indent: int):
+    """_numbers of the run, CHUNK lines at a time (small scratch arrays, reused: fewer page faults)."""
+    parts = [_numbers(data, starts, a, min(CHUNK, first + count - a), indent) for a in range(first, first + count, CHUNK)]
+    wrong = [a - first + np.asarray(w, dtype=np.int64) for a, (_, _, w) in zip(range(first, first + count, CHUNK), parts)]
+    if any(len(w) for w in wrong):
+        return None, None, np.concatenate(wrong)
+    return np.concatenate([c for c, _, _ in parts]), np.concatenate([r for _, r, _ in parts]), []
 
 
 def _numbers(data: bytes, starts: np.ndarray, first: int, count: int, indent: int):
