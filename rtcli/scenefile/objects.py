@@ -130,8 +130,8 @@ class ObjectBuilder:
             p.known("materials")
             material = material_ref(p, "material", self.named, self.table, inherited)
         else:
-            rows = np.array([material_ref(_one(item, where, p.folder), "material", self.named, self.table, inherited)
-                             for item, where, _ in p.items("materials")], dtype=np.int64)
+            rows = np.array([material_ref(_one(item, where, p.folder, path), "material", self.named, self.table,
+                                          inherited) for item, where, path in p.items("materials")], dtype=np.int64)
             if len(rows) == 0 or arrays.index.max(initial=0) >= len(rows):
                 raise p.error("materials", f"material_index goes up to {arrays.index.max(initial=0)}, but "
                                            f"{len(rows)} materials are listed")
@@ -215,9 +215,9 @@ class ObjectBuilder:
         return p.sub(kind)
 
 
-def _one(item, where, folder: str) -> Params:
-    """Params holding one entry of a `materials` list as its `material` key."""
+def _one(item, where, folder: str, path: str) -> Params:
+    """Params holding entry `path` of a `materials` list as its `material` key."""
     node = MapNode.empty(where, folder)
     node["material"] = item
     node.places.extend((node.places[0], node.places[0]))
-    return Params(node, "")
+    return Params(node, path)
