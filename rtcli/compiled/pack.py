@@ -186,8 +186,9 @@ def geometry(scene, tree: bool, bvh: tuple | None = None, levels=None) -> tuple[
         if shape.FIRST_COLUMN is not None:
             row[shape.FIRST_COLUMN] = n_pool
         if shape.ROOT_COLUMN is not None:
-            row[shape.ROOT_COLUMN] = trees.add(shape.bvh, np.arange(len(shape.pool)) + n_pool)
-            mesh_depth = max(mesh_depth, shape.bvh.depth)
+            tree = shape.tree(levels)                       # a mesh's, by the compiled build when given
+            row[shape.ROOT_COLUMN] = trees.add(tree, np.arange(len(shape.pool)) + n_pool)
+            mesh_depth = max(mesh_depth, tree.depth)
         if len(row) > SHAPE_WIDTH:
             raise ValueError(f"a {type(shape).__name__} row is wider than {SHAPE_WIDTH} columns")
         if len(shape.pool):
