@@ -131,3 +131,15 @@ def test_a_run_read_in_chunks_is_the_same(tmp_path, monkeypatch):
     bulk, usual = both(write(tmp_path, HEAD + "\n".join(lines) + "\n"), monkeypatch)
     assert [(s, len(b)) for s, b in sphere_blocks(bulk.objects)] == [(0, 70), (71, 79)]
     same_objects(bulk, usual)
+
+
+def test_an_animated_scene_keeps_its_run_in_every_frame(tmp_path, monkeypatch):
+    from rtcli.scenefile.load import load_animation
+    text = ("animation: {fps: 1, frames: 2}\n" + HEAD + "\n".join(spheres(80)) + "\n"
+            "  - {sphere: {radius: 1}, transform: [{translate: {keys: {0: [0, 0, 0], 1: [0, 2, 0]}}}]}\n")
+    animation, first, _ = load_animation(write(tmp_path, text))
+    second = animation.scene(2)
+    assert [len(b) for _, b in sphere_blocks(second.objects)] == [80] and len(second.objects) == 81
+    assert second.objects[80].world_from_object.m[1, 3] == 2.0 and first.objects[80].world_from_object is None \
+        or first.objects[80].world_from_object.m[1, 3] == 0.0
+    assert np.array_equal(first.boxes.lo[:80], second.boxes.lo[:80])
