@@ -40,6 +40,7 @@ golden: $(FULL)
 bench: warmup
 	-$(PY) -m pip install --quiet -e '.[bench]' || echo "the bench extra (mitsuba, embreex) did not install: timing without them"
 	$(PY) bench/run.py
+	$(PY) bench/run.py --scenes million,torus1m
 	$(PY) bench/rays.py
 
 clean:

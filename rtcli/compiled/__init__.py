@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rtcli.compiled.build import runner
 from rtcli.compiled.loading import Load, cached, ready, say
 from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
@@ -50,7 +51,7 @@ class Compiled:
 
     def __init__(self, scene, bvh: bool = True, notes=None, start: float | None = None):
         start = time.perf_counter() if start is None else start
-        self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh)
+        self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh, levels=runner())
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
         self.frames = frames(self.looks.max_depth)
         nowhere, none = Camera(*np.zeros((4, 3))), np.zeros(0)

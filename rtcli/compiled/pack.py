@@ -40,11 +40,13 @@ from collections import namedtuple
 import numpy as np
 
 from rtcli.core.bvh import BVH, padded
+from rtcli.core.objects import singles, sphere_blocks
 from rtcli.core.scene import object_tree
 from rtcli.core.transform import PACKED
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import POOL_WIDTH
 from rtcli.shapes.csg import CSG, OPS
+from rtcli.shapes.sphere import Sphere
 
 SHAPE_WIDTH = 20                                   # columns of an object row: the widest shape's row
 KIND, XFORM, CASTS, MATERIAL = range(4)            # columns of ints
@@ -76,7 +78,7 @@ Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror 
 
 def unsupported(scene) -> str | None:
     """Why the compiled engine cannot render `scene`, or None when it can."""
-    for o in scene.objects:
+    for _, o in singles(scene.objects):                 # a block's spheres are supported
         if type(o.shape) not in KINDS and not isinstance(o.shape, CSG):
             return f"{o.kind or type(o.shape).__name__} objects"
     return None
@@ -164,14 +166,15 @@ class _Trees:
                 np.concatenate(self.perm).astype(np.int64))
 
 
-def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int]:
+def geometry(scene, tree: bool, bvh: tuple | None = None, levels=None) -> tuple[Geometry, int]:
     """The scene's geometry, and the traversal stack it needs (the scene's tree, then a mesh's).
-    Without `tree` every object is listed, in file order; `bvh`: object_tree's, if made already."""
+    Without `tree` every object is listed, in file order; `bvh`: object_tree's, if made already;
+    `levels`: the compiled tree build (core/bvh_build.py; the same tree as numpy's, sooner)."""
     n = len(scene.objects)
     objects, ints = np.zeros((n, SHAPE_WIDTH)), np.zeros((n, 4), dtype=np.int64)
     bounded = scene.boxes.bounded
     listed = np.flatnonzero(~bounded | (not tree))
-    members, scene_bvh = (bvh or object_tree(scene)) if tree else (np.zeros(0, np.int64), BVH(np.zeros((0, 3)),
+    members, scene_bvh = (bvh or object_tree(scene, levels)) if tree else (np.zeros(0, np.int64), BVH(np.zeros((0, 3)),
                                                                                              np.zeros((0, 3))))
     trees, mesh_depth, transforms, csgs, csg_scratch = _Trees(), 0, [], _CSGs(n), 0
     trees.add(scene_bvh, members)                    # root 0
@@ -184,8 +187,9 @@ def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int
         if shape.FIRST_COLUMN is not None:
             row[shape.FIRST_COLUMN] = n_pool
         if shape.ROOT_COLUMN is not None:
-            row[shape.ROOT_COLUMN] = trees.add(shape.bvh, np.arange(len(shape.pool)) + n_pool)
-            mesh_depth = max(mesh_depth, shape.bvh.depth)
+            tree = shape.tree(levels)                       # a mesh's, by the compiled build when given
+            row[shape.ROOT_COLUMN] = trees.add(tree, np.arange(len(shape.pool)) + n_pool)
+            mesh_depth = max(mesh_depth, tree.depth)
         if len(row) > SHAPE_WIDTH:
             raise ValueError(f"a {type(shape).__name__} row is wider than {SHAPE_WIDTH} columns")
         if len(shape.pool):
@@ -193,7 +197,12 @@ def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int
             n_pool += len(shape.pool)
         return row
 
-    for k, o in enumerate(scene.objects):
+    for start, block in sphere_blocks(scene.objects):          # spheres kept as arrays (core/objects.py)
+        end = start + len(block)
+        objects[start:end, :block.rows.shape[1]] = block.rows
+        ints[start:end] = np.stack([np.full(len(block), KINDS[Sphere]), np.full(len(block), -1),
+                                    scene.materials.shadow[block.material], block.material], axis=1)
+    for k, o in singles(scene.objects):
         shape = o.shape
         if isinstance(shape, CSG):
             objects[k], kind = csgs.add(shape, transforms), CSG_KIND

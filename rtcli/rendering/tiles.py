@@ -22,6 +22,7 @@ import numpy as np
 
 from rtcli.core.display import to_8bit, to_8bit_alpha
 from rtcli.core.jitter import sample_positions
+from rtcli.core.objects import object_ids
 from rtcli.core.scene import Scene
 from rtcli.rendering import engine as engines
 from rtcli.rendering.pool import held_signals, interrupted_once, stop_pool, watch_worker, worker_died
@@ -61,7 +62,7 @@ def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
             rays = camera_rays(cam, i + 0.5, j + 0.5, job.width, job.height)
             hits = find_first_hit(scene, rays)
             stats.primary += len(rays)
-            ids = np.array([o.id for o in scene.objects] + [0], dtype=np.uint16)
+            ids = object_ids(scene.objects)
             return ids[hits.obj], stats
         xs, ys = sample_positions(i, j, scene.settings.samples)
         stats.primary += xs.size

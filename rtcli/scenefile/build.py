@@ -17,6 +17,7 @@ from rtcli.core import camera as cameras
 from rtcli.core.elementary import cos
 from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
+from rtcli.core.objects import kind_counts
 from rtcli.core.scene import Scene, Settings
 from rtcli.core.vec import unit3
 from rtcli.errors import SceneError, plural
@@ -220,10 +221,7 @@ def light_from(p: Params) -> PointLight:
 def summary(scene: Scene) -> str:
     """One line for `rtcli validate`."""
     s = scene.settings
-    kinds = {}
-    for o in scene.objects:
-        kinds[o.kind] = kinds.get(o.kind, 0) + 1
-    shapes = ", ".join(f"{n} {k}" for k, n in kinds.items())
+    shapes = ", ".join(f"{n} {k}" for k, n in kind_counts(scene.objects).items())
     return (f"{plural(len(scene.objects), 'object')} ({shapes or 'none'}), {plural(len(scene.lights), 'light')}, "
             f"{plural(len(scene.materials) - 1, 'material')}; {s.width}x{s.height}, max_depth {s.max_depth}, "
             f"{s.specular}, samples {s.samples}")

@@ -162,7 +162,7 @@ def test_a_read_only_copy_of_rtcli_uses_the_per_user_cache(tmp_path):
     for folder in [copy, *(p for p in copy.rglob("*") if p.is_dir())]:
         folder.chmod(0o555)
     try:
-        code = "from rtcli import variants as v; w = v.cache_location(); print(v.PACKAGE_DIR, w.root, w.why)"
+        code = "from rtcli.kernels import numba_cache as v; w = v.cache_location(); print(v.PACKAGE_DIR, w.root, w.why)"
         env = {**os.environ, "PYTHONPATH": str(copy.parent), "XDG_CACHE_HOME": str(tmp_path / "c")}
         env.pop(numba_cache.CACHE_ENV, None), env.pop("NUMBA_CACHE_DIR", None)
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env,
