@@ -41,6 +41,7 @@ class RtcliGroup(click.Group):
         # spin after each small matrix product of a scene's transforms, taking the workers' cores
         # (whitted at 1920x1080 on 2 cores: 13% more CPU). Set before numpy is first imported.
         os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+        whole_process = args is None           # the process's own command line: its exit is the process's
         args = list(sys.argv[1:] if args is None else args)
         extra.pop("standalone_mode", None)
         if not args:
@@ -54,7 +55,7 @@ class RtcliGroup(click.Group):
         except click.exceptions.Exit as e:
             sys.exit(e.exit_code)
         except (Interrupted, click.exceptions.Abort) as e:
-            restore = _ignore_signals()                # the first signal decides; the exit is bounded
+            restore = _ignore_signals(whole_process, restore)   # the first signal decides; the exit is bounded
             if sys.stderr.isatty():
                 click.echo(err=True)                   # end the line the terminal's ^C is on
             click.echo("error: interrupted", err=True)
@@ -91,13 +92,15 @@ def _nul_argument(args: list[str]) -> str | None:
     return None
 
 
-def _ignore_signals():
-    """Ignore SIGINT and SIGTERM from now on (a process on its way out after the first: a later
-    one, a supervisor's SIGTERM to the group, would otherwise kill it by the default action half
-    way through its exit); returns the undo, which does nothing."""
-    if threading.current_thread() is threading.main_thread():
-        for s in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(s, signal.SIG_IGN)
+def _ignore_signals(whole_process: bool, restore):
+    """In a process on its way out after a first SIGINT or SIGTERM, ignore both from now on: a later
+    one (a supervisor's SIGTERM to the group just after a Ctrl-C) would otherwise kill it by the
+    default action half way through its exit. Returns the undo: `restore` when the command runs
+    inside another program (its tests, a notebook), which goes on after it; else nothing."""
+    if not whole_process or threading.current_thread() is not threading.main_thread():
+        return restore
+    for s in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(s, signal.SIG_IGN)
     return lambda: None
 
 
