@@ -1,0 +1,152 @@
+"""Whether a Dask scheduler listens at an address, found out within the connect deadline
+(docs/cluster.md, "Connecting"): a port that refuses, a peer that accepts and says nothing (a
+dashboard's port, an 8786/8787 typo), one that speaks HTTP or another protocol, or a Dask worker
+given for the scheduler, each in one line, before Dask's client (which would wait forever on a
+silent peer, or read an HTTP answer as the length of a 3 EiB message) is started.
+
+A Dask scheduler speaks first: it sends its handshake as soon as it accepts a connection. So
+for tcp:// the first bytes tell: a Dask frame's length, "HTTP/...", anything else, or nothing.
+Silence is then asked in HTTP, which a dashboard answers. Then Dask's own handshake and an
+`identity` call say whether the peer is the scheduler (not a worker or a nanny).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import random
+import socket
+import struct
+import threading
+import time
+
+from rtcli.cluster.target import connect_timeout
+from rtcli.errors import RtcliError
+
+DEFAULT_DEADLINE = 20.0           # seconds to connect, unless --cluster-timeout or Dask's shorter timeout says
+HTTP_SHARE = 0.25                 # the share of the deadline kept for asking a silent peer in HTTP ...
+HTTP_AT_MOST = 2.0                # ... at most this many seconds
+DASK_FRAME_AT_MOST = 1 << 26      # a Dask handshake's length is far below this (HTTP/ reads as 3 EiB)
+
+
+def deadline(given: float | None) -> float:
+    """The seconds a connection may take: --cluster-timeout's, else 20 s (or Dask's connect
+    timeout, distributed.comm.timeouts.connect, when that is set shorter)."""
+    return given if given is not None else min(DEFAULT_DEADLINE, connect_timeout())
+
+
+class Clock:
+    """What is left of a deadline of `seconds`, from now."""
+
+    def __init__(self, seconds: float):
+        self.seconds, self.end = seconds, time.monotonic() + seconds
+
+    def left(self) -> float:
+        return max(0.0, self.end - time.monotonic())
+
+
+def probe(address: str, seconds: float, distributed) -> None:
+    """RtcliError, in one line, unless a Dask scheduler answers at `address` (scheme://host:port,
+    target.py checked it) within `seconds`."""
+    clock = Clock(seconds)
+    scheme, rest = address.split("://", 1)
+    if scheme not in ("tcp", "tls", "ws", "wss"):         # inproc://, a scheduler in this process
+        return
+    host, port = rest.rsplit(":", 1)
+    sock = _connected(address, host.strip("[]"), int(port), clock)
+    with sock:
+        if scheme == "tcp":                # tls and ws peers wait for the client's first word
+            _sniffed(address, sock, clock)
+    _identity(address, clock, distributed)
+
+
+def _connected(address: str, host: str, port: int, clock: Clock) -> socket.socket:
+    """A TCP connection to host:port, tried again (as Dask does) while the peer refuses, until the
+    deadline."""
+    attempt = 0
+    while True:
+        try:
+            return socket.create_connection((host, port), timeout=max(clock.left(), 0.01))
+        except socket.gaierror as e:
+            raise RtcliError(f"cannot reach the Dask scheduler at {address}: {host}: {e.strerror}") from None
+        except OSError:
+            if clock.left() <= 0:
+                raise RtcliError(f"cannot reach the Dask scheduler at {address}: Timed out trying to connect "
+                                 f"to {address} after {clock.seconds:g} s") from None
+        attempt += 1
+        time.sleep(min(clock.left(), random.uniform(0, 0.01 * 2 ** min(attempt, 8))))
+
+
+def _sniffed(address: str, sock: socket.socket, clock: Clock) -> None:
+    """Return if the peer's first bytes are a Dask frame's; else RtcliError saying what it is."""
+    ask_http = min(HTTP_AT_MOST, clock.seconds * HTTP_SHARE)
+    first = _received(sock, clock.left() - ask_http)
+    if first is None:                                   # silent: ask it in HTTP
+        sock.sendall(b"GET / HTTP/1.0\r\n\r\n")
+        answer = _received(sock, clock.left())
+        if answer and answer.startswith(b"HTTP/"):
+            raise _not_dask(address, "speaks HTTP (a web server, or a Dask dashboard)")
+        raise _not_dask(address, f"accepted the connection but said nothing within {clock.seconds:g} s")
+    if first.startswith(b"HTTP/"):
+        raise _not_dask(address, "speaks HTTP (a web server, or a Dask dashboard)")
+    if not first:
+        raise _not_dask(address, "closed the connection without a word")
+    if len(first) < 8 or struct.unpack("<Q", first[:8])[0] > DASK_FRAME_AT_MOST:
+        raise _not_dask(address, f"answered in another protocol than Dask's (its first bytes: {first[:16]!r})")
+
+
+def _received(sock: socket.socket, seconds: float) -> bytes | None:
+    """Up to 64 bytes the peer sends within `seconds` (b"" if it closed), or None if it sent none."""
+    if seconds <= 0:
+        return None
+    sock.settimeout(seconds)
+    try:
+        return sock.recv(64)
+    except TimeoutError:
+        return None
+    except OSError:
+        return b""
+
+
+def _not_dask(address: str, what: str) -> RtcliError:
+    return RtcliError(f"{address} is not a Dask scheduler: it {what}; give the address `dask scheduler` "
+                      "prints (tcp://HOST:8786 by default; 8787 is its dashboard)")
+
+
+def _identity(address: str, clock: Clock, distributed) -> None:
+    """Dask's handshake and an `identity` call, in a thread of their own (the caller may have an
+    event loop running) within the deadline: the peer must say it is a Scheduler."""
+    found: dict = {}
+
+    def run():
+        try:
+            found["type"] = asyncio.run(asyncio.wait_for(_ask(address, clock, distributed), clock.left()))
+        except BaseException as e:                  # told in this thread's caller, below
+            found["error"] = e
+    thread = threading.Thread(target=run, name="rtcli-probe", daemon=True)
+    thread.start()
+    thread.join(clock.left() + 1)
+    error, kind = found.get("error"), found.get("type")
+    if (error is None and kind is None) or isinstance(error, TimeoutError):
+        raise _not_dask(address, f"accepted the connection but did not answer as Dask does within "
+                                 f"{clock.seconds:g} s")
+    if isinstance(error, (ValueError, TypeError)) and "TLS" in str(error):
+        raise RtcliError(f"cannot reach the Dask scheduler at {address}: {' '.join(str(error).split())} "
+                         "(docs/cluster.md, TLS)") from None
+    if error is not None:
+        raise _not_dask(address, f"did not answer as Dask does ({type(error).__name__})")
+    if kind != "Scheduler":
+        raise RtcliError(f"{address} is a Dask {str(kind).lower()}, not the scheduler: give the address "
+                         "`dask scheduler` prints (tcp://HOST:8786 by default)")
+
+
+async def _ask(address: str, clock: Clock, distributed):
+    """The `type` the peer's identity names, after Dask's handshake (with the security of Dask's
+    configuration, as the client will use)."""
+    args = distributed.Security().get_connection_args("client")
+    comm = await distributed.comm.connect(address, timeout=max(clock.left(), 0.01), **args)
+    try:
+        await comm.write({"op": "identity", "reply": True})
+        reply = await comm.read()
+    finally:
+        comm.abort()
+    return reply.get("type") if isinstance(reply, dict) else None
