@@ -12,10 +12,13 @@ render).
 
 from __future__ import annotations
 
+import re
+
 from rtcli.cluster.software import OtherSoftware, fingerprint, mismatch
 from rtcli.errors import RtcliError
 
 TRIES = 4                         # times a task is submitted, at most, when workers refuse it
+WRAPPED = re.compile(r"(\w+)\((['\"])(.*)\2\)", re.S)      # a worker's error, as text: Name('message')
 
 
 def survey(client) -> dict:
@@ -35,8 +38,14 @@ def survey(client) -> dict:
 
 
 def cannot_run(address: str, what) -> RtcliError:
-    why = f"{type(what).__name__}: {' '.join(str(what).split())}" if isinstance(what, BaseException) else \
-        f"it answered {type(what).__name__}"
+    """The refusal of a worker where rtcli's `fingerprint` failed with `what` (or gave no dict)."""
+    if not isinstance(what, BaseException):
+        why = f"it answered {type(what).__name__}"
+    elif type(what) is Exception and (wrapped := WRAPPED.fullmatch(str(what))):    # as Client.run gives it
+        why = f"{wrapped[1]}: {wrapped[3]}"
+    else:
+        why = f"{type(what).__name__}: {what}"
+    why = " ".join(why.split())
     return RtcliError(f"the worker {address} cannot run rtcli ({why}); install the same rtcli and libraries "
                       "on every worker")
 
@@ -53,8 +62,7 @@ class LeftOut:
         new = [address for address, why in sorted(refusals.items()) if why is not None and address not in self.workers]
         for address in new:
             self.workers[address] = refusals[address]
-            self.notes(f"{refusals[address]}: left out (it gets no task of this command); the other workers "
-                       "take its tasks")
+            self.notes(f"{refusals[address]} (left out: the other workers take its tasks)")
         return new
 
     def usable(self) -> list[str]:
