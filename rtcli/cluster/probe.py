@@ -13,8 +13,10 @@ Silence is then asked in HTTP, which a dashboard answers. Then Dask's own handsh
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import random
 import socket
+import ssl
 import struct
 import threading
 import time
@@ -55,7 +57,7 @@ def probe(address: str, seconds: float, distributed) -> None:
     sock = _connected(address, host.strip("[]"), int(port), clock)
     with sock:
         if scheme == "tcp":                # tls and ws peers wait for the client's first word
-            _sniffed(address, sock, clock)
+            _sniffed(address, sock, clock, (host.strip("[]"), int(port)))
     _identity(address, clock, distributed)
 
 
@@ -76,15 +78,20 @@ def _connected(address: str, host: str, port: int, clock: Clock) -> socket.socke
         time.sleep(min(clock.left(), random.uniform(0, 0.01 * 2 ** min(attempt, 8))))
 
 
-def _sniffed(address: str, sock: socket.socket, clock: Clock) -> None:
-    """Return if the peer's first bytes are a Dask frame's; else RtcliError saying what it is."""
+def _sniffed(address: str, sock: socket.socket, clock: Clock, where: tuple) -> None:
+    """Return if the peer's first bytes are a Dask frame's; else RtcliError saying what it is (a silent
+    peer is asked in HTTP; one that hangs up then, in TLS, at `where`)."""
     ask_http = min(HTTP_AT_MOST, clock.seconds * HTTP_SHARE)
     first = _received(sock, clock.left() - ask_http)
-    if first is None:                                   # silent: ask it in HTTP
-        sock.sendall(b"GET / HTTP/1.0\r\n\r\n")
+    if first is None:
+        with contextlib.suppress(OSError):
+            sock.sendall(b"GET / HTTP/1.0\r\n\r\n")
         answer = _received(sock, clock.left())
         if answer and answer.startswith(b"HTTP/"):
             raise _not_dask(address, "speaks HTTP (a web server, or a Dask dashboard)")
+        if answer == b"" and _speaks_tls(where, clock.left()):
+            raise RtcliError(f"{address} speaks TLS: give it as tls://{address.split('://', 1)[1]}, with Dask's TLS "
+                             "settings (docs/cluster.md, TLS)")
         raise _not_dask(address, f"accepted the connection but said nothing within {clock.seconds:g} s")
     if first.startswith(b"HTTP/"):
         raise _not_dask(address, "speaks HTTP (a web server, or a Dask dashboard)")
@@ -92,6 +99,20 @@ def _sniffed(address: str, sock: socket.socket, clock: Clock) -> None:
         raise _not_dask(address, "closed the connection without a word")
     if len(first) < 8 or struct.unpack("<Q", first[:8])[0] > DASK_FRAME_AT_MOST:
         raise _not_dask(address, f"answered in another protocol than Dask's (its first bytes: {first[:16]!r})")
+
+
+def _speaks_tls(where: tuple, seconds: float) -> bool:
+    """Whether the peer at (host, port) completes a TLS handshake within `seconds` (its certificate
+    unchecked: only the protocol is asked)."""
+    if seconds <= 0:
+        return False
+    context = ssl.create_default_context()
+    context.check_hostname, context.verify_mode = False, ssl.CERT_NONE
+    try:
+        with socket.create_connection(where, timeout=seconds) as raw, context.wrap_socket(raw):
+            return True
+    except (OSError, ValueError):
+        return False
 
 
 def _received(sock: socket.socket, seconds: float) -> bytes | None:
@@ -130,8 +151,15 @@ def _identity(address: str, clock: Clock, distributed) -> None:
         raise _not_dask(address, f"accepted the connection but did not answer as Dask does within "
                                  f"{clock.seconds:g} s")
     if isinstance(error, (ValueError, TypeError)) and "TLS" in str(error):
-        raise RtcliError(f"cannot reach the Dask scheduler at {address}: {' '.join(str(error).split())} "
-                         "(docs/cluster.md, TLS)") from None
+        raise RtcliError(f"{address}: Dask's TLS settings are missing here (distributed.comm.tls.ca-file, "
+                         ".client.cert and .client.key; docs/cluster.md, TLS)") from None
+    if error is not None and address.startswith("tls://"):
+        detail = " ".join(str(error).split()) or type(error).__name__
+        raise RtcliError(f"cannot reach the Dask scheduler at {address} in TLS ({detail}): a scheduler without TLS? "
+                         f"then give tcp://{address.split('://', 1)[1]}") from None
+    if isinstance(error, OSError) and not isinstance(error, ConnectionResetError):
+        detail = " ".join(str(error).split()) or type(error).__name__
+        raise RtcliError(f"cannot reach the Dask scheduler at {address}: {detail}") from None
     if error is not None:
         raise _not_dask(address, f"did not answer as Dask does ({type(error).__name__})")
     if kind != "Scheduler":
