@@ -232,13 +232,14 @@ def test_cannot_run_rtcli_names_the_worker():
 
 
 def test_a_still_on_a_tcp_cluster_through_the_probe_is_the_local_render(scene):
-    """A real scheduler passes the probe (and the client it is followed by) well within the deadline."""
+    """A real scheduler passes the probe (and the client it is followed by), in a fresh process with
+    the default deadline."""
     cluster = distributed.LocalCluster(n_workers=1, processes=False, protocol="tcp", host="127.0.0.1",
                                        dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
     try:
         assert rtcli("render", "scene.yaml", "-o", "local.png", cwd=scene)[0] == 0
         code, _, err, _ = rtcli("render", "scene.yaml", "-o", "c.png", "--cluster", cluster.scheduler_address,
-                                "--cluster-timeout", "10", cwd=scene)
+                                cwd=scene)                         # the default deadline (Dask's config read)
         assert code == 0, err
         assert (scene / "c.png").read_bytes() == (scene / "local.png").read_bytes()
     finally:

@@ -43,12 +43,12 @@ class Session:
 
     def __init__(self, where: Target, notes=None):
         self.where, self.client, self.cluster, self.futures = where, None, None, []
-        self.heard, self.left_out, self.made = Heard(notes or say), None, {}
-        self.deadline = deadline(where.timeout)
+        self.heard, self.left_out, self.made, self.deadline = Heard(notes or say), None, {}, None
         self._quiet = contextlib.ExitStack()
 
     def __enter__(self) -> Session:
         distributed = load_distributed()
+        self.deadline = deadline(self.where.timeout)         # Dask's configuration is there once it is imported
         self._quiet.enter_context(_quiet())
         try:
             self._connect(distributed)
