@@ -250,3 +250,11 @@ def test_renders_reach_takes_the_timeout_to_the_session():
     with renders.Reach(Target("tcp://127.0.0.1:1", timeout=0.3)) as reach:
         with pytest.raises(RtcliError, match=r"after 0.3 s$"):
             reach.session()
+
+
+@pytest.mark.parametrize("command", [["render", "scene.yaml", "-o", "c.png"], ["warmup"]])
+def test_the_timeout_without_a_cluster_is_refused(scene, command):
+    code, out, err, _ = rtcli(*command, "--cluster-timeout", "3", cwd=scene)
+    assert (code, out, err) == (2, "", "error: --cluster-timeout goes with --cluster, --cluster-file or "
+                                       "--local-cluster\n")
+    assert not (scene / "c.png").exists()

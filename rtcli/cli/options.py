@@ -73,6 +73,8 @@ def reach(address, file, local, notes, timeout=None):
     rtcli.cluster (and Dask) only when one is named. The workers' notes go to `notes`
     (terminal.note: stderr, above the progress bar); `timeout`: --cluster-timeout."""
     if not (address or file or local):
+        if timeout is not None:
+            raise click.UsageError("--cluster-timeout goes with --cluster, --cluster-file or --local-cluster")
         return None
     from rtcli.cluster.renders import Reach  # start-up: Dask only when asked
     from rtcli.cluster.target import target
