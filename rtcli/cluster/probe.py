@@ -70,6 +70,8 @@ def _connected(address: str, host: str, port: int, clock: Clock) -> socket.socke
             return socket.create_connection((host, port), timeout=max(clock.left(), 0.01))
         except socket.gaierror as e:
             raise RtcliError(f"cannot reach the Dask scheduler at {address}: {host}: {e.strerror}") from None
+        except (OverflowError, ValueError) as e:           # a port no socket can have
+            raise RtcliError(f"cannot reach the Dask scheduler at {address}: {e}") from None
         except OSError:
             if clock.left() <= 0:
                 raise RtcliError(f"cannot reach the Dask scheduler at {address}: Timed out trying to connect "
@@ -97,6 +99,8 @@ def _sniffed(address: str, sock: socket.socket, clock: Clock, where: tuple) -> N
         raise _not_dask(address, "speaks HTTP (a web server, or a Dask dashboard)")
     if not first:
         raise _not_dask(address, "closed the connection without a word")
+    while len(first) < 8 and (more := _received(sock, clock.left())):     # a frame's length may come in parts
+        first += more
     if len(first) < 8 or struct.unpack("<Q", first[:8])[0] > DASK_FRAME_AT_MOST:
         raise _not_dask(address, f"answered in another protocol than Dask's (its first bytes: {first[:16]!r})")
 
