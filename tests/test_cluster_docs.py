@@ -48,8 +48,8 @@ objects:
 def CHANGES(port: int) -> list[tuple[str, str]]:
     """What changes in the pages' commands here: the machines' addresses and network become
     loopback, the ports free ones, the sizes small."""
-    return [("10.0.0.1", "127.0.0.1"), ("10.0.0.2", "127.0.0.1"), (":8786", f":{port}"),
-            ("--port 8786", f"--port {port}"), ("127.0.0.1:8787", "127.0.0.1:0"),
+    return [("10.0.0.1", "127.0.0.1"), ("10.0.0.2", "127.0.0.1"), ("10.0.0.3", "127.0.0.1"), (":8786", f":{port}"),
+            ("--port 8786", f"--port {port}"), ('"port": 8786', f'"port": {port}'), ("127.0.0.1:8787", "127.0.0.1:0"),
             ("--worker-port 9000:9099", "--worker-port 0"),
             ("--nanny-port 9100:9199", "--nanny-port 0"), ("--nworkers 8", "--nworkers 1"),
             ("--interface ib0", "--interface lo"), ('interface="ib0"', 'interface="lo"'),
