@@ -6,7 +6,7 @@ silent peer, or read an HTTP answer as the length of a 3 EiB message) is started
 
 A Dask scheduler speaks first: it sends its handshake as soon as it accepts a connection. So
 for tcp:// the first bytes tell: a Dask frame's length, "HTTP/...", anything else, or nothing.
-Silence is then asked in HTTP, which a dashboard answers. Then Dask's own handshake and an
+Silence is then asked in HTTP, which a dashboard answers at once. Then Dask's own handshake and an
 `identity` call say whether the peer is the scheduler (not a worker or a nanny).
 """
 
@@ -25,8 +25,8 @@ from rtcli.cluster.target import connect_timeout
 from rtcli.errors import RtcliError
 
 DEFAULT_DEADLINE = 20.0           # seconds to connect, unless --cluster-timeout or Dask's shorter timeout says
-HTTP_SHARE = 0.25                 # the share of the deadline kept for asking a silent peer in HTTP ...
-HTTP_AT_MOST = 2.0                # ... at most this many seconds
+ASK_AFTER = 2.0                   # seconds of a peer's silence before it is asked in HTTP ...
+ASK_SHARE = 0.25                  # ... or this share of the deadline, when that is shorter
 DASK_FRAME_AT_MOST = 1 << 26      # a Dask handshake's length is far below this (HTTP/ reads as 3 EiB)
 
 
@@ -81,20 +81,19 @@ def _connected(address: str, host: str, port: int, clock: Clock) -> socket.socke
 
 
 def _sniffed(address: str, sock: socket.socket, clock: Clock, where: tuple) -> None:
-    """Return if the peer's first bytes are a Dask frame's; else RtcliError saying what it is (a silent
-    peer is asked in HTTP; one that hangs up then, in TLS, at `where`)."""
-    ask_http = min(HTTP_AT_MOST, clock.seconds * HTTP_SHARE)
-    first = _received(sock, clock.left() - ask_http)
+    """Return if the peer's first bytes are a Dask frame's; else RtcliError saying what it is. A peer
+    silent for ASK_AFTER seconds is asked in HTTP (a scheduler slower than that still speaks first:
+    its handshake comes whatever it was sent); one that hangs up then is asked in TLS, at `where`."""
+    first = _received(sock, min(ASK_AFTER, clock.seconds * ASK_SHARE))
     if first is None:
         with contextlib.suppress(OSError):
             sock.sendall(b"GET / HTTP/1.0\r\n\r\n")
-        answer = _received(sock, clock.left())
-        if answer and answer.startswith(b"HTTP/"):
-            raise _not_dask(address, "speaks HTTP (a web server, or a Dask dashboard)")
-        if answer == b"" and _speaks_tls(where, clock.left()):
+        first = _received(sock, clock.left())
+        if first is None:
+            raise _not_dask(address, f"accepted the connection but said nothing within {clock.seconds:g} s")
+        if first == b"" and _speaks_tls(where, clock.left()):
             raise RtcliError(f"{address} speaks TLS: give it as tls://{address.split('://', 1)[1]}, with Dask's TLS "
                              "settings (docs/cluster.md, TLS)")
-        raise _not_dask(address, f"accepted the connection but said nothing within {clock.seconds:g} s")
     if first.startswith(b"HTTP/"):
         raise _not_dask(address, "speaks HTTP (a web server, or a Dask dashboard)")
     if not first:
