@@ -31,6 +31,7 @@ from rtcli.cluster.target import Target
 from rtcli.errors import RtcliError
 
 distributed = pytest.importorskip("distributed")
+slow = pytest.mark.slow          # an rtcli process each, or a Dask scheduler
 
 SCENE = """\
 image: {width: 24, height: 16}
@@ -127,6 +128,7 @@ def refused_in_one_line(scene, port, what: str) -> float:
     return seconds
 
 
+@slow
 def test_a_peer_that_accepts_and_never_speaks_is_one_line_within_the_deadline(scene):
     with server(silent) as port:
         refused_in_one_line(scene, port, f"accepted the connection but said nothing within {DEADLINE:g} s")
@@ -142,11 +144,27 @@ def test_a_silent_peer_costs_the_deadline_not_more():
         assert 1.9 <= time.monotonic() - start < 2.0 + 5
 
 
+@pytest.mark.parametrize("peer, what", [
+    ("http", "speaks HTTP (a web server, or a Dask dashboard)"),
+    (ssh_like, "answered in another protocol than Dask's (its first bytes: b'SSH-2.0-OpenSSH_')"),
+    (closing, "closed the connection without a word"),
+])
+def test_the_probe_tells_what_answers_instead_of_a_scheduler(peer, what):
+    """In this process (the command's one line is checked by the slow tests): a peer silent for
+    1.25 s (a quarter of the deadline) is asked in HTTP."""
+    with http_server() if peer == "http" else server(peer) as port:
+        with pytest.raises(RtcliError) as e:
+            probes.probe(f"tcp://127.0.0.1:{port}", 5.0, distributed)
+    assert str(e.value) == f"tcp://127.0.0.1:{port} is not a Dask scheduler: it {what}; {ADVICE}"
+
+
+@slow
 def test_a_server_that_speaks_http_is_one_line(scene):
     with http_server() as port:
         refused_in_one_line(scene, port, "speaks HTTP (a web server, or a Dask dashboard)")
 
 
+@slow
 def test_the_schedulers_own_dashboard_port_is_one_line(scene):
     """The 8786/8787 typo: the port of a real scheduler's HTTP server (its dashboard) instead of its own."""
     cluster = distributed.LocalCluster(n_workers=0, processes=False, protocol="tcp", host="127.0.0.1",
@@ -158,6 +176,7 @@ def test_the_schedulers_own_dashboard_port_is_one_line(scene):
         cluster.close()
 
 
+@slow
 @pytest.mark.parametrize("answer, what", [
     (ssh_like, "answered in another protocol than Dask's (its first bytes: b'SSH-2.0-OpenSSH_')"),
     (closing, "closed the connection without a word"),
@@ -167,6 +186,7 @@ def test_a_peer_that_answers_otherwise_is_one_line(scene, answer, what):
         refused_in_one_line(scene, port, what)
 
 
+@slow
 @pytest.mark.parametrize("port", ["0", "99999", "123456"])
 def test_a_port_that_cannot_exist_is_one_line_at_once(scene, port):
     code, out, err, _ = rtcli("render", "scene.yaml", "-o", "c.png", "--cluster", f"127.0.0.1:{port}", cwd=scene)
@@ -178,6 +198,7 @@ def test_a_port_that_cannot_exist_is_one_line_at_once(scene, port):
     assert (code, out) == (2, "") and not (scene / "c.png").exists()
 
 
+@slow
 def test_a_refused_port_gives_up_at_the_deadline(scene):
     with socket.create_server(("127.0.0.1", 0)) as taken:
         port = taken.getsockname()[1]
@@ -186,6 +207,7 @@ def test_a_refused_port_gives_up_at_the_deadline(scene):
                               f"to connect to tcp://127.0.0.1:{port} after 0.5 s\n")
 
 
+@slow
 def test_a_worker_given_for_the_scheduler_is_named(scene):
     cluster = distributed.LocalCluster(n_workers=1, processes=False, protocol="tcp", host="127.0.0.1",
                                        dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
@@ -209,6 +231,7 @@ def test_the_deadline_is_the_option_else_20_s_or_dasks_when_shorter():
         assert probes.deadline(None) == 4.0 and probes.deadline(9) == 9
 
 
+@slow
 @pytest.mark.parametrize("command", ["render", "signature", "warmup"])
 def test_every_cluster_command_takes_the_timeout_option(scene, command):
     code, out, _, _ = rtcli(command, "--help", cwd=scene)
@@ -231,6 +254,7 @@ def test_cannot_run_rtcli_names_the_worker():
                                          "worker")
 
 
+@slow
 def test_a_still_on_a_tcp_cluster_through_the_probe_is_the_local_render(scene):
     """A real scheduler passes the probe (and the client it is followed by), in a fresh process with
     the default deadline."""
@@ -252,6 +276,7 @@ def test_renders_reach_takes_the_timeout_to_the_session():
             reach.session()
 
 
+@slow
 @pytest.mark.parametrize("command", [["render", "scene.yaml", "-o", "c.png"], ["warmup"]])
 def test_the_timeout_without_a_cluster_is_refused(scene, command):
     code, out, err, _ = rtcli(*command, "--cluster-timeout", "3", cwd=scene)

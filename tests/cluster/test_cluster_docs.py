@@ -3,11 +3,11 @@ run as written, on loopback, with only addresses and sizes changed (CHANGES).
 
 - The set-up of several machines and its TLS variant: `dask scheduler`, `dask worker` and
   `rtcli render` as processes on 127.0.0.1, with the certificates made by the page's openssl lines.
-- SLURM's page: tests/test_cluster_slurm.py; the SSHCluster script: tests/test_cluster_ssh.py.
+- SLURM's page: tests/cluster/test_cluster_slurm.py; the SSHCluster script: tests/cluster/test_cluster_ssh.py.
 - Every rtcli line of the three pages, Kubernetes' included (no cluster here), is accepted by
   rtcli's command line, its address as rtcli reads it.
 
-`rtcli warmup` lines compile the engine on the workers (minutes when cold): tests/test_cluster.py
+`rtcli warmup` lines compile the engine on the workers (minutes when cold): tests/cluster/test_cluster.py
 warms clusters it starts. Every process started here is stopped at the end of its test.
 """
 
@@ -29,8 +29,9 @@ from rtcli.cli import main
 from rtcli.cluster.target import target
 
 distributed = pytest.importorskip("distributed")
+slow = pytest.mark.slow          # Dask schedulers and worker processes, started as the page says
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 PAGES = ["cluster.md", "cluster-slurm.md", "cluster-kubernetes.md"]
 BOUND = 240                      # seconds a page's commands may take here
 SCENE = """\
@@ -167,6 +168,7 @@ def wait_listening(port: int) -> None:
 
 
 # --- docs/cluster.md ---
+@slow
 def test_the_set_up_of_several_machines_runs_on_loopback(here, processes):
     folder, env = here
     port = free_port()
@@ -181,6 +183,7 @@ def test_the_set_up_of_several_machines_runs_on_loopback(here, processes):
     rendered_as_here(folder, "scene.png", env, "scene.yaml")
 
 
+@slow
 @pytest.mark.skipif(not os.path.exists("/usr/bin/openssl"), reason="no openssl to make the certificates")
 def test_the_tls_set_up_runs_on_loopback(here, processes):
     folder, env = here
@@ -205,6 +208,7 @@ def test_the_tls_set_up_runs_on_loopback(here, processes):
     rendered_as_here(folder, "scene.png", env, "scene.yaml")
 
 
+@slow
 def test_the_fingerprint_line_prints_what_rtcli_compares(here):
     folder, env = here
     line = block("cluster.md", "sh", "fingerprint()").strip()

@@ -26,6 +26,7 @@ from rtcli.rendering import tiles as tiling
 from rtcli.rendering.tiles import Job, render
 
 distributed = pytest.importorskip("distributed")
+pytestmark = pytest.mark.slow   # Dask schedulers and worker processes
 
 SCENE = """\
 image: {width: 24, height: 16}

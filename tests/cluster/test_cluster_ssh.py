@@ -4,7 +4,7 @@ This machine has no sshd, and one could not run here without root's set-up; so t
 asyncssh's own, in a thread of the test: it logs in the test's key only and runs each command
 with /bin/sh, as sshd does. Dask's SSHCluster is the real client: it logs in, starts the
 scheduler and the workers with their command lines, and stops them on Ctrl-C. The machines'
-addresses, the network and the sizes change as in tests/test_cluster_docs.py; the login (port,
+addresses, the network and the sizes change as in tests/cluster/test_cluster_docs.py; the login (port,
 key, no known_hosts) is the test server's; remote_python is this Python.
 """
 
@@ -22,8 +22,9 @@ from test_cluster_docs import BOUND, block, changed, commands, free_port, here, 
 
 asyncssh = pytest.importorskip("asyncssh")
 distributed = pytest.importorskip("distributed")
+pytestmark = pytest.mark.slow   # an SSH server, a Dask scheduler and worker processes
 
-__all__ = ["here"]                # the fixture, shared with tests/test_cluster_docs.py
+__all__ = ["here"]                # the fixture, shared with tests/cluster/test_cluster_docs.py
 
 
 class Server(asyncssh.SSHServer):

@@ -2,7 +2,7 @@
 script under bash, as SLURM's batch step would run it, with an `srun` that runs its command once
 here; dask-jobqueue's script with an `sbatch` that runs the job's script here, in a session of its
 own, and an `scancel` that stops it. Addresses, network and sizes change as in
-tests/test_cluster_docs.py (CHANGES).
+tests/cluster/test_cluster_docs.py (CHANGES).
 """
 
 from __future__ import annotations
@@ -15,8 +15,9 @@ import pytest
 from test_cluster_docs import BOUND, block, changed, commands, here, kill_group, processes, rendered_as_here, run
 
 distributed = pytest.importorskip("distributed")
+pytestmark = pytest.mark.slow   # Dask schedulers and worker processes, started as the page says
 
-__all__ = ["here", "processes"]   # the fixtures, shared with tests/test_cluster_docs.py
+__all__ = ["here", "processes"]   # the fixtures, shared with tests/cluster/test_cluster_docs.py
 
 
 SRUN = """#!/bin/sh
