@@ -61,8 +61,8 @@ def check_size(model, width, height) -> tuple[int, int, str | None]:
 
 
 def cluster_options(doing: str = "Render on", extra: str = " --workers is then unused."):
-    """--cluster, --cluster-file and --local-cluster (README.md, Clusters), their help saying what
-    the command does there."""
+    """--cluster, --cluster-file, --local-cluster and --cluster-timeout (README.md, Clusters;
+    docs/cluster.md), their help saying what the command does there."""
     def add(command):
         for option in reversed((
                 click.option("--cluster", metavar="tcp://HOST:PORT", callback=not_empty,
@@ -71,18 +71,23 @@ def cluster_options(doing: str = "Render on", extra: str = " --workers is then u
                 click.option("--cluster-file", metavar="SCHEDULER.json", callback=not_empty,
                              help=f"{doing} the Dask cluster named by this scheduler file."),
                 click.option("--local-cluster", type=click.IntRange(1, 256), metavar="N",
-                             help=f"{doing} a Dask cluster of N worker processes started on this machine."))):
+                             help=f"{doing} a Dask cluster of N worker processes started on this machine."),
+                click.option("--cluster-timeout", type=click.FloatRange(0.1, 3600), metavar="SECONDS",
+                             help="Give up connecting to the cluster after this long (default 20, or Dask's "
+                                  "connect timeout when shorter)."))):
             command = option(command)
         return command
     return add
 
 
-def reach(address, file, local, notes):
+def reach(address, file, local, notes, timeout=None):
     """The cluster the options name (a cluster.renders.Reach, to use in a `with` block), or None;
     rtcli.cluster (and Dask) only when one is named. The workers' notes go to `notes`
-    (terminal.note: stderr, above the progress bar)."""
+    (terminal.note: stderr, above the progress bar); `timeout`: --cluster-timeout."""
     if not (address or file or local):
+        if timeout is not None:
+            raise click.UsageError("--cluster-timeout goes with --cluster, --cluster-file or --local-cluster")
         return None
     from rtcli.cluster.renders import Reach  # start-up: Dask only when asked
     from rtcli.cluster.target import target
-    return Reach(target(address, file, local), notes)
+    return Reach(target(address, file, local, timeout), notes)

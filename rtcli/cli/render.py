@@ -44,6 +44,7 @@ class Options:
     cluster: str | None
     cluster_file: str | None
     local_cluster: int | None
+    cluster_timeout: float | None
     watch: bool
     bit_depth: str = "8"
     half: bool = False
@@ -166,7 +167,7 @@ def render(**options):
     check_engine(o.engine)
     if o.stats:                     # why a machine code file is not used, if one is not
         machinecode.report_to(terminal.note)
-    where = reach(o.cluster, o.cluster_file, o.local_cluster, terminal.note)
+    where = reach(o.cluster, o.cluster_file, o.local_cluster, terminal.note, o.cluster_timeout)
     lint = terminal.lint(o.quiet, o.strict, o.several, o.watch)
     with where or contextlib.nullcontext():
         if o.sequence and not o.several:

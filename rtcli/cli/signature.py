@@ -25,7 +25,7 @@ from rtcli.errors import one_line
 @click.option("--frame", type=click.IntRange(1), metavar="N", help="Frame N of an animated scene (default 1).")
 @cluster_options()
 def signature(scene_file, output, ids_out, legend, width, height, block_size, workers, frame,
-              cluster, cluster_file, local_cluster):
+              cluster, cluster_file, local_cluster, cluster_timeout):
     """Write the scene signature: each pixel shows the id of the first object hit (notes 000 11.4)."""
     import numpy as np  # start-up
 
@@ -35,7 +35,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
     from rtcli.cli.render_stills import on_cluster
     from rtcli.core.display import signature_colors
     from rtcli.rendering.writer import write_images
-    where = reach(cluster, cluster_file, local_cluster, note)
+    where = reach(cluster, cluster_file, local_cluster, note, cluster_timeout)
     loaded, scene = load(scene_file, frame, keep=where is not None)
     out = output_name(scene_file, output, ".sig.png")
     check_outputs([(out, False)] + ([(ids_out, True)] if ids_out else []), scene.inputs)

@@ -12,9 +12,11 @@ import threading
 import warnings
 
 from rtcli.cluster.bundle import Bundle
+from rtcli.cluster.leftout import LeftOut, survey
 from rtcli.cluster.notes import TOPIC, Heard
-from rtcli.cluster.software import fingerprint, mismatch
-from rtcli.cluster.target import Target, connect_timeout, load_distributed
+from rtcli.cluster.probe import Clock, deadline, probe
+from rtcli.cluster.software import fingerprint
+from rtcli.cluster.target import Target, load_distributed
 from rtcli.cluster.tasks import blob, frame_task, tiles_task
 from rtcli.compiled.loading import say
 from rtcli.errors import RtcliError, shown
@@ -41,11 +43,12 @@ class Session:
 
     def __init__(self, where: Target, notes=None):
         self.where, self.client, self.cluster, self.futures = where, None, None, []
-        self.heard = Heard(notes or say)
+        self.heard, self.left_out, self.made, self.deadline = Heard(notes or say), None, {}, None
         self._quiet = contextlib.ExitStack()
 
     def __enter__(self) -> Session:
         distributed = load_distributed()
+        self.deadline = deadline(self.where.timeout)         # Dask's configuration is there once it is imported
         self._quiet.enter_context(_quiet())
         try:
             self._connect(distributed)
@@ -64,27 +67,33 @@ class Session:
                     dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
             self.client = distributed.Client(self.cluster, set_as_default=False)
             return
+        clock = Clock(self.deadline)
+        probe(self.where.address, self.deadline, distributed)      # a Dask scheduler, or one line
         try:
-            self.client = distributed.Client(self.where.address, set_as_default=False)
+            self.client = distributed.Client(self.where.address, set_as_default=False,
+                                             timeout=max(clock.left(), 1.0))
         except (OSError, TimeoutError, ValueError) as e:
             raise RtcliError(f"cannot reach the Dask scheduler at {shown(self.where.address)}: "
                              f"{' '.join(str(e).split())}") from None
 
     def _check_workers(self) -> None:
-        """Refuse workers whose software differs; wait a while for a first worker."""
+        """Wait a while for a first worker; leave out the workers that cannot run this rtcli or run
+        other software (leftout.py), or refuse the cluster if no other worker is left."""
         distributed = load_distributed()
         try:
-            self.client.wait_for_workers(1, timeout=connect_timeout())
+            self.client.wait_for_workers(1, timeout=self.deadline)
         except (TimeoutError, distributed.TimeoutError):
             raise RtcliError(f"{self.where} has no workers (start some: README.md, Clusters)") from None
         try:
-            found = self.client.run(fingerprint)
-        except Exception as e:            # a worker without rtcli, or with one too old to say what it runs
+            found = survey(self.client)
+        except Exception as e:            # the cluster could not be asked
             raise RtcliError(f"the workers of {self.where} cannot run rtcli ({type(e).__name__}: {e}); install "
                              "the same rtcli and libraries on every worker") from None
-        for address, theirs in sorted(found.items()):
-            if (refusal := mismatch(fingerprint(), theirs, address)) is not None:
-                raise refusal
+        refusals = [why for why in found.values() if why is not None]
+        if found and len(refusals) == len(found):
+            raise refusals[0]
+        self.left_out = LeftOut(self.client, self.heard.notes)
+        self.left_out.add(found)
 
     @property
     def threads(self) -> int:
@@ -116,7 +125,7 @@ class Session:
     def tiles(self, bundle: Bundle, overrides: dict, frame: int, job, traced: int, tiles: list, samples: int):
         """The results of every tile, group by group as they finish."""
         spec, blobs = self.send(bundle, overrides)
-        self.futures = [self.client.submit(tiles_task, spec, blobs, frame, job, traced, group, pure=False)
+        self.futures = [self._submit(tiles_task, spec, blobs, frame, job, traced, group)
                         for group in groups(tiles, samples, self.threads)]
         for results in self._finished():
             yield from results
@@ -124,8 +133,7 @@ class Session:
     def frames(self, bundle: Bundle, overrides: dict, frames: list[int], job):
         """(frame, image, stats) of each frame, as they finish."""
         spec, blobs = self.send(bundle, overrides)
-        self.futures = [self.client.submit(frame_task, spec, blobs, k, job, pure=False, priority=-k)
-                        for k in frames]
+        self.futures = [self._submit(frame_task, spec, blobs, k, job, priority=-k) for k in frames]
         yield from self._finished()
 
     def run(self, function, *args) -> dict:
@@ -140,12 +148,37 @@ class Session:
         except (distributed.CancelledError, OSError) as e:
             raise RtcliError(f"lost {self.where} ({type(e).__name__})") from None
 
+    def _submit(self, function, *args, priority: int = 0, tries: int = 1, workers=None):
+        """A task of this command, remembered so that it can be submitted again (_again)."""
+        future = self.client.submit(function, *args, pure=False, priority=priority, workers=workers,
+                                    allow_other_workers=workers is not None)
+        self.made[future.key] = (function, args, priority, tries)
+        return future
+
+    def _again(self, future):
+        """The failed task `future` submitted again, to the workers not left out, when a worker
+        refused it or one that would is found now (leftout.py); else None."""
+        function, args, priority, tries = self.made[future.key]
+        workers = self.left_out.again(future.exception(), tries)
+        if workers is None:
+            return None
+        del self.made[future.key]
+        future.release()
+        return self._submit(function, *args, priority=priority, tries=tries + 1, workers=workers)
+
     def _finished(self):
-        """The futures' results as they finish; then which workers compiled the engine meanwhile."""
+        """The futures' results as they finish (a task that a worker refused, again elsewhere); then
+        which workers compiled the engine meanwhile."""
         distributed = load_distributed()
         try:
-            for future in distributed.as_completed(self.futures, loop=self.client.loop):
+            running = distributed.as_completed(self.futures, loop=self.client.loop)
+            for future in running:
+                if future.status == "error" and (again := self._again(future)) is not None:
+                    self.futures.append(again)
+                    running.add(again)
+                    continue
                 yield future.result()
+                self.made.pop(future.key, None)
                 future.release()
             self.heard.summary()
         except distributed.KilledWorker as e:

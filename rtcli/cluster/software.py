@@ -32,11 +32,23 @@ def fingerprint() -> dict:
     return _fingerprint
 
 
-def mismatch(client: dict, worker: dict, where: str) -> RtcliError | None:
+class OtherSoftware(RtcliError):
+    """A worker's refusal: its software differs from the client's. `worker`: its address (the client
+    leaves it out, leftout.py)."""
+
+    def __init__(self, message: str, worker: str):
+        super().__init__(message)
+        self.worker = worker
+
+    def __reduce__(self):            # pickled from the worker to the client with its address
+        return type(self), (str(self), self.worker)
+
+
+def mismatch(client: dict, worker: dict, where: str) -> OtherSoftware | None:
     """The refusal when a worker's fingerprint differs from the client's, or None."""
     differ = [f"{name} {client.get(name)} here, {worker.get(name)} there"
               for name in sorted(set(client) | set(worker)) if client.get(name) != worker.get(name)]
     if not differ:
         return None
-    return RtcliError(f"the worker {where} runs other software ({'; '.join(differ)}): its pixels could differ; "
-                      "install the same rtcli and libraries on every worker")
+    return OtherSoftware(f"the worker {where} runs other software ({'; '.join(differ)}): its pixels could differ; "
+                         "install the same rtcli and libraries on every worker", where)

@@ -20,6 +20,7 @@ class Target:
     address: str | None = None
     file: str | None = None
     local: int = 0
+    timeout: float | None = None          # --cluster-timeout (probe.deadline: its default)
 
     def __str__(self) -> str:
         if self.local:
@@ -27,8 +28,8 @@ class Target:
         return f"the Dask scheduler at {shown(self.address)}"
 
 
-def target(address: str | None, file: str | None, local: int | None) -> Target | None:
-    """The Target the options name (at most one of them), or None."""
+def target(address: str | None, file: str | None, local: int | None, timeout: float | None = None) -> Target | None:
+    """The Target the options name (at most one of them), or None; `timeout`: --cluster-timeout."""
     given = [name for name, value in (("--cluster", address), ("--cluster-file", file),
                                       ("--local-cluster", local)) if value]
     if len(given) > 1:
@@ -39,7 +40,7 @@ def target(address: str | None, file: str | None, local: int | None) -> Target |
         address = scheduler_address(file)
     if address:
         address = _checked_address(address, f"--cluster-file {shown(file)}: its address" if file else "--cluster")
-    return Target(address, file, local or 0)
+    return Target(address, file, local or 0, timeout)
 
 
 def _checked_address(address: str, what: str) -> str:
@@ -47,6 +48,9 @@ def _checked_address(address: str, what: str) -> str:
     full = address if "://" in address else f"tcp://{address}"
     if not re.fullmatch(r"(tcp|tls|ws|wss)://(\[[0-9a-fA-F:.]+\]|[^\s/:\[\]]+):\d{1,5}", full):
         raise RtcliError(f"{what} {shown(address)}: give the scheduler's address as tcp://HOST:PORT")
+    if not 1 <= int(full.rsplit(":", 1)[1]) <= 65535:
+        raise RtcliError(f"{what} {shown(address)}: no port can be {int(full.rsplit(':', 1)[1])}: give the "
+                         "scheduler's port, 1 to 65535 (8786 by default)")
     return full
 
 

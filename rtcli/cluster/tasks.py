@@ -9,7 +9,7 @@ import threading
 from collections import OrderedDict
 
 from rtcli.cluster.notes import told
-from rtcli.cluster.software import fingerprint, mismatch
+from rtcli.cluster.software import OtherSoftware, fingerprint, mismatch
 from rtcli.errors import RtcliError
 from rtcli.rendering import engine as engines
 from rtcli.rendering import tiles as rendering
@@ -80,6 +80,8 @@ def tiles_task(spec: dict, blobs: dict, frame: int, job, traced: int, tiles: lis
         for *_, stats in results:
             stats.engine = "compiled" if engine else "numpy"
         return results
+    except OtherSoftware:
+        raise
     except RtcliError as e:
         raise RtcliError(str(e)) from None
 
@@ -104,5 +106,7 @@ def frame_task(spec: dict, blobs: dict, frame: int, job):
         if notes:
             notes.compiled(stats.compile_seconds)
         return frame, image, stats
+    except OtherSoftware:
+        raise
     except RtcliError as e:
         raise RtcliError(str(e)) from None
