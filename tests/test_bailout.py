@@ -173,7 +173,7 @@ def test_deepest_shown():
 
 def test_explain_command_max_nodes_bounds_text_and_json(tmp_path):
     path = tmp_path / "deep.yaml"
-    path.write_text(deep(16, "0", "0.5", "0.5", "false"))
+    path.write_text(deep(12, "0", "0.5", "0.5", "false"))
     run = lambda *args: CliRunner().invoke(main, ["explain", str(path), "25", "17", *args])   # noqa: E731
     start = time.monotonic()
     text, data = run("--max-nodes", "50"), run("--max-nodes", "50", "--json")

@@ -36,8 +36,8 @@ class Recorder(Log):
     """The engine's recorder (wavefront/trace.py) for one ray: fills a RayNode. Rays deeper than
     `shown_to` (None: none) are summarised (budget.py)."""
 
-    def __init__(self, scene: Scene, node: RayNode, shown_to: int | None = None):
-        self.scene, self.node, self.shown_to = scene, node, shown_to
+    def __init__(self, scene: Scene, node: RayNode, shown_to: int | None = None, left: list | None = None):
+        self.scene, self.node, self.shown_to, self.left = scene, node, shown_to, left
 
     def rays(self, rays: Rays, depth: int, hits) -> None:
         self.node.origin, self.node.direction = rays.o[:, 0].copy(), rays.d[:, 0].copy()
@@ -99,11 +99,15 @@ class Recorder(Log):
                                 float(R[0]), tir, self.node.hit.coefficients["fresnel"])
 
     def child(self, rows, kind: str, weights) -> Recorder | Summary:
+        if self.left is not None:                         # a first pass, given up past the budget
+            self.left[0] -= 1
+            if self.left[0] < 0:
+                raise OverBudget
         node = RayNode(kind, self.node.depth + 1, np.zeros(3), np.zeros(3), weights[:, 0].copy())
         self.node.children.append(node)
         if self.shown_to is not None and node.depth > self.shown_to:
             return Summary(node)
-        return Recorder(self.scene, node, self.shown_to)
+        return Recorder(self.scene, node, self.shown_to, self.left)
 
     def bailout(self, rows, kind: str, weights, path) -> None:
         self.node.bailouts.append(Bailout(kind, weights[:, 0].copy(), path[:, 0].copy(),
@@ -128,14 +132,25 @@ def coefficients(table, m: int) -> dict:
 
 def trace_one(scene: Scene, x: float, y: float, width: int, height: int, max_nodes: int = MAX_NODES) -> RayNode:
     """The tree of the primary ray through image position (x, y) of a width x height image, its
-    rays past the node budget summarised (budget.py)."""
+    rays past the node budget summarised (budget.py): when the whole tree does not fit, its rays
+    of each depth are counted first."""
     rays = camera_rays(scene.camera(width, height), np.array([x]), np.array([y]), width, height)
-    root = RayNode("primary", 1, rays.o[:, 0], rays.d[:, 0])
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        root = RayNode("primary", 1, rays.o[:, 0], rays.d[:, 0])
+        try:
+            trace(scene, rays, 1, Stats(), log=Recorder(scene, root, left=[max_nodes - 1]))
+            return root
+        except OverBudget:
+            pass
         levels = Levels()
         trace(scene, rays, 1, Stats(), log=levels)
+        root = RayNode("primary", 1, rays.o[:, 0], rays.d[:, 0])
         trace(scene, rays, 1, Stats(), log=Recorder(scene, root, deepest_shown(levels.count, max_nodes)))
     return root
+
+
+class OverBudget(Exception):
+    """The tree has more rays than the budget: a first pass gives up."""
 
 
 def explain_pixel(model, x: int, y: int, width: int, height: int, gamma: bool = False,
