@@ -191,3 +191,18 @@ def test_explain_command_max_nodes_bounds_text_and_json(tmp_path):
         assert result.exit_code == 2 and "--max-nodes" in result.output and "Traceback" not in result.output
     with pytest.raises(rtcli.RtcliError, match="max_nodes must be an integer in 1..1000000, got 0"):
         rtcli.explain(str(path), 25, 17, max_nodes=0)
+
+
+def test_a_deep_glass_scene_explains_in_bounded_output(tmp_path):
+    """The scene that used to print hundreds of megabytes: Fresnel glass at max_depth 20, explained
+    with the scene's default cutoff and the default node budget, as text and as JSON."""
+    path = tmp_path / "deep.yaml"
+    path.write_text(deep(20).replace(", adc_bailout: 1.0e-6", ""))
+    run = lambda *args: CliRunner().invoke(main, ["explain", str(path), "25", "17", *args])   # noqa: E731
+    text, data = run(), run("--json")
+    assert text.exit_code == data.exit_code == 0, text.output + data.output
+    assert text.output.count("ray, depth") <= 3000 and len(text.output) < 3_000_000
+    assert len(data.output) < 30_000_000
+    image, _ = render(load_scene(str(path)), Job(40, 30))
+    assert json.loads(data.output)["byte"] == image[17, 25].tolist()
+    assert f"-> 8-bit {tuple(image[17, 25].tolist())}" in text.output
