@@ -15,6 +15,7 @@ import contextlib
 import multiprocessing
 import os
 import time
+import weakref
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
@@ -96,18 +97,23 @@ def trace_in_parts(engine, cam, x: np.ndarray, y: np.ndarray, job: Job, stats: S
 
     Python runs a signal's handler only between two of its own steps, never inside machine code,
     so one call over a tile of minutes would hold Ctrl-C and SIGTERM back for minutes. Each part
-    takes about PART_SECONDS (its size follows the rays' measured speed, from PART_RAYS), so an
+    takes about PART_SECONDS: its size follows the rays' measured speed (from PART_RAYS, and from
+    the engine's last part on its later tiles, which are then mostly one part each), so an
     interrupt ends the render within a moment. Every ray's color depends on the ray alone: the
     parts change no pixel."""
-    colors, start, size = np.empty((len(x), 3)), 0, PART_RAYS
+    colors, start, size = np.empty((len(x), 3)), 0, _part_rays.get(engine, PART_RAYS)
     while start < len(x):
         began = time.perf_counter()
         end = min(start + size, len(x))
         colors[start:end] = engine.trace_pixels(cam, x[start:end], y[start:end], job.width, job.height, stats)
         took = time.perf_counter() - began
-        size = max(PART_RAYS // 8, min(2 * size, int(size * PART_SECONDS / took) if took > 0 else 2 * size))
+        size = max(PART_RAYS // 8, min(2 * size, int((end - start) * PART_SECONDS / took) if took > 0 else 2 * size))
         start = end
+    _part_rays[engine] = size
     return colors
+
+
+_part_rays: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()     # an engine's next part, in rays
 
 
 def _tiles(job: Job, samples: int = 1):
