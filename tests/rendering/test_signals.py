@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from helpers import SLOW, scene_from_yaml
 
-from rtcli import variants
+from rtcli.kernels import variants
 from rtcli.errors import Interrupted
 from rtcli.rendering.tiles import PART_RAYS, PART_SECONDS, Job, render, trace_in_parts
 from rtcli.stats import Stats
