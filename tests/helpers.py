@@ -132,3 +132,25 @@ def image_summary(path, ignore=()) -> tuple:
 def same_image(a, b, ignore=()) -> bool:
     """Whether two image files hold the same pixels and provenance (image_summary)."""
     return image_summary(a, ignore) == image_summary(b, ignore)
+
+
+# Two glass balls inside a third: most rays stay inside, and each surface sends two on (the deep
+# ray trees of render: adc_bailout and explain's node budget).
+DEEP = """
+image: {width: 40, height: 30}
+camera: {eye: [0, 0, 4.5], look_at: [0, 0, 0], fov: 50}
+background: [0.3, 0.5, 0.8]
+render: {max_depth: DEPTH, adc_bailout: BAILOUT}
+lights: [{position: [2, 2.5, 3]}]
+materials:
+  glass: {diffuse: 0.1, reflection: REFLECTION, transmission: TRANSMISSION, ior: 1.5, fresnel: FRESNEL}
+objects:
+  - {sphere: {center: [-1, 0, 0], radius: 0.9}, material: glass}
+  - {sphere: {center: [1, 0, 0], radius: 0.9}, material: glass}
+  - {sphere: {center: [0, 0, 0], radius: 6}, material: glass}
+"""
+
+
+def deep(depth=20, bailout="1.0e-6", reflection="1", transmission="1", fresnel="true") -> str:
+    return (DEEP.replace("DEPTH", str(depth)).replace("BAILOUT", bailout).replace("REFLECTION", reflection)
+            .replace("TRANSMISSION", transmission).replace("FRESNEL", fresnel))

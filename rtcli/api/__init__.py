@@ -25,6 +25,7 @@ from rtcli.api.pictures import Progress, render_scene, signature_scene
 from rtcli.api.results import ImageArray
 from rtcli.api.scene import Scene, Source
 from rtcli.errors import RtcliError
+from rtcli.inspect.budget import MAX_NODES
 from rtcli.inspect.explain import Explanation, check_pixel, explain_pixel
 from rtcli.inspect.views import KINDS, picture, view_of
 from rtcli.rendering.engine import numpy_engine
@@ -111,14 +112,16 @@ def view(scene: Scene | Source, kind: str, *, width: int | None = None, height: 
 
 def explain(scene: Scene | Source, x: int, y: int, *, width: int | None = None, height: int | None = None,
             samples: int | None = None, max_depth: int | None = None, gamma: bool = False,
-            bvh: bool = True) -> Explanation:
+            bvh: bool = True, max_nodes: int = MAX_NODES) -> Explanation:
     """The ray trees of pixel (x, y) (column from the left, row from the top) of a Scene, or of
-    what load_scene takes; the size and settings as render takes them (docs/debugging.md)."""
-    check_options(width=width, height=height, samples=samples, max_depth=max_depth, gamma=gamma, bvh=bvh)
+    what load_scene takes; the size and settings as render takes them (docs/debugging.md). Each
+    sample's tree shows at most about max_nodes rays in full, the deeper ones summarised."""
+    check_options(width=width, height=height, samples=samples, max_depth=max_depth, gamma=gamma, bvh=bvh,
+                  max_nodes=max_nodes)
     if not isinstance(scene, Scene):
         scene = load_scene(scene, width=width, height=height)
     w, h, _ = image_size(scene.model, width, height)
     check_pixel(x, y, w, h)
     with scene.model.settings.overridden(samples, max_depth):
         numpy_engine(scene.model, bvh)
-        return explain_pixel(scene.model, x, y, w, h, gamma)
+        return explain_pixel(scene.model, x, y, w, h, gamma, max_nodes)

@@ -14,7 +14,7 @@ RANGES = {"width": (1, 32768), "height": (1, 32768), "samples": (1, 16), "max_de
           "workers": (1, 256), "block_size": (1, 1024), "tile": (1, 4096),
           "frame": (1, 100_000),          # as the command line's (frame: scenefile.clock.MAX_FRAMES)
           "tolerance": (0, 255), "max_bad_pixels": (0, None), "max_cluster": (0, None),   # rtcli.diff's gate
-          "max_boundary_mismatch": (0, None)}
+          "max_boundary_mismatch": (0, None), "max_nodes": (1, 1_000_000)}   # max_nodes: explain's, as --max-nodes
 FRACTIONS = ("max_bad_fraction", "max_boundary_fraction")        # numbers in 0..1
 PATHS = ("output", "folder")
 CALLBACKS = ("progress", "notes")

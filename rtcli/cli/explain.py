@@ -25,7 +25,10 @@ from rtcli.cli.options import SIZE, check_size, load
 @click.option("--gamma", is_flag=True, help="The 8-bit value sRGB-encoded, as render --gamma writes it.")
 @click.option("--no-bvh", is_flag=True, help="No BVH over the scene's objects, as render --no-bvh.")
 @click.option("--frame", type=click.IntRange(1), metavar="N", help="Frame N of an animated scene (default 1).")
-def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_samples, as_json, gamma, no_bvh, frame):
+@click.option("--max-nodes", type=click.IntRange(1, 1_000_000), default=1000, show_default=True, metavar="N",
+              help="Rays shown in full per sample's tree; the deeper ones are summarised.")
+def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_samples, as_json, gamma, no_bvh, frame,
+            max_nodes):
     """Explain why pixel (X, Y) has its color: its ray tree, every term of the shading equation
     with its numbers, and the sum at every ray (X from the left, Y from the top, from 0)."""
     from rtcli.api import explain as explain_pixel  # start-up
@@ -34,7 +37,8 @@ def explain(scene_file, x, y, width, height, samples, max_depth, sample, all_sam
     _, scene = load(scene_file, frame)
     check_size(scene.model, width, height)
     scene.override(width=width, height=height)
-    e = explain_pixel(scene, x, y, samples=samples, max_depth=max_depth, gamma=gamma, bvh=not no_bvh)
+    e = explain_pixel(scene, x, y, samples=samples, max_depth=max_depth, gamma=gamma, bvh=not no_bvh,
+                      max_nodes=max_nodes)
     if sample is not None and sample >= e.samples ** 2:
         raise click.BadParameter(f"{sample} is not a sample of this pixel: it has {e.samples ** 2} "
                                  f"(0 to {e.samples ** 2 - 1})", param_hint="'--sample'")

@@ -29,6 +29,7 @@ from rtcli.compiled.pack import (
     MEDIA_COUNT,
     MEDIA_IOR,
     NG,
+    PATH_WEIGHT,
     REFRACTED_DIR,
     STAGE,
     W_REFLECT,
@@ -195,16 +196,26 @@ def shade_local(g, s, ray, f, counts, stack):
 
 
 @per_ray(inline=True)
+def followed(s, f, w, child):
+    """Whether the secondary ray of weights f[w:w + 3] is traced: its path weight, the frame's times
+    those weights (set in the child frame), is at least adc_bailout in some channel (trace.followed)."""
+    r, g, b = f[PATH_WEIGHT] * f[w], f[PATH_WEIGHT + 1] * f[w + 1], f[PATH_WEIGHT + 2] * f[w + 2]
+    child[PATH_WEIGHT], child[PATH_WEIGHT + 1], child[PATH_WEIGHT + 2] = r, g, b
+    return r >= s.adc_bailout or g >= s.adc_bailout or b >= s.adc_bailout
+
+
+@per_ray(inline=True)
 def next_ray(s, f, child, counts):
     """The frame's next secondary ray (trace.shade): the mirror ray at stage 0 (if its weight is
-    not 0), the refracted ray at stage 1 (none past the critical angle: its weight is 0);
-    (False, _) when none is left. Each starts s.offset off the surface, on the side it leaves to;
-    its media go into the child frame (the mirror ray stays in the ray's media)."""
+    not 0), the refracted ray at stage 1 (none past the critical angle: its weight is 0), each only
+    if its path weight reaches adc_bailout; (False, _) when none is left. Each starts s.offset off
+    the surface, on the side it leaves to; its media go into the child frame (the mirror ray stays
+    in the ray's media)."""
     depth = s.max_depth
     ex, ey, ez = s.offset * f[NG], s.offset * f[NG + 1], s.offset * f[NG + 2]
     if f[STAGE] == 0:
         f[STAGE] = 1
-        if f[W_REFLECT] > 0 or f[W_REFLECT + 1] > 0 or f[W_REFLECT + 2] > 0:
+        if (f[W_REFLECT] > 0 or f[W_REFLECT + 1] > 0 or f[W_REFLECT + 2] > 0) and followed(s, f, W_REFLECT, child):
             counts[REFLECTED] += 1
             for j in range(MEDIA_COUNT, MEDIA_IOR + depth):
                 child[j] = f[j]
@@ -212,7 +223,7 @@ def next_ray(s, f, child, counts):
             return True, (f[P] + ex, f[P + 1] + ey, f[P + 2] + ez, rx, ry, rz)
     if f[STAGE] == 1:
         f[STAGE] = 2
-        if f[W_REFRACT] > 0 or f[W_REFRACT + 1] > 0 or f[W_REFRACT + 2] > 0:
+        if (f[W_REFRACT] > 0 or f[W_REFRACT + 1] > 0 or f[W_REFRACT + 2] > 0) and followed(s, f, W_REFRACT, child):
             counts[REFRACTED] += 1
             m = int(f[MATERIAL_OF])
             child[MEDIA_COUNT] = refracted_media(f[MEDIA_IOR:MEDIA_IOR + depth], int(f[MEDIA_COUNT]), s.ior[m],
@@ -228,6 +239,7 @@ def radiance(g, s, ray, counts, frames, stack):
     depth first with frames[L] the pending hit at depth L + 1 instead of recursion."""
     L = 0
     frames[0, MEDIA_COUNT] = 0                                        # the camera is in the scene's medium
+    frames[0, PATH_WEIGHT:PATH_WEIGHT + 3] = 1.0                      # and the primary's path weight is 1
     while True:
         found, cr, cg, cb = shade_local(g, s, ray, frames[L], counts, stack)
         more = False

@@ -64,16 +64,17 @@ ROW, DEPTH, PATH = 1, 2, 4                         # columns of leaves (KIND and
 # far, the hit point p, the facing shading normal n and geometric normal ng, the unit direction
 # D of the ray that hit, entering (1 or 0), the material, which secondary ray comes next (STAGE:
 # 0 the mirror ray, 1 the refracted ray, 2 done), the weights of the mirror and refracted rays,
-# the refracted direction, and the media the ray is in: how many, then their iors (max_depth
-# slots from MEDIA_IOR on).
+# the refracted direction, the path weight of the ray that hit (adc_bailout's, wavefront/trace.py),
+# and the media the ray is in: how many, then their iors (max_depth slots from MEDIA_IOR on).
 (COLOR_SUM, P, N, NG, D, ENTERING, MATERIAL_OF, STAGE,
- W_REFLECT, W_REFRACT, REFRACTED_DIR, MEDIA_COUNT, MEDIA_IOR) = 0, 3, 6, 9, 12, 15, 16, 17, 18, 21, 24, 27, 28
+ W_REFLECT, W_REFRACT, REFRACTED_DIR, PATH_WEIGHT, MEDIA_COUNT, MEDIA_IOR) = (0, 3, 6, 9, 12, 15, 16, 17, 18, 21, 24,
+                                                                            27, 30, 31)
 
 # Few arrays on purpose: numba passes each array argument as several machine words.
 Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool program leaves")
 Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear fresnel filters texture "
                             "texels lights samples ambient background offset max_depth blinn medium_ior "
-                            "reflect_tir any_filter terminator")
+                            "reflect_tir any_filter terminator adc_bailout")
 
 
 def unsupported(scene) -> str | None:
@@ -242,7 +243,8 @@ def looks(scene) -> Looks:
                  samples, np.asarray(scene.ambient, float), np.asarray(scene.background, float),
                  float(scene.offset), int(scene.settings.max_depth), scene.settings.specular == "blinn",
                  float(scene.settings.medium_ior), scene.settings.total_internal_reflection == "reflect",
-                 bool(table.filters.any()), scene.settings.shadow_terminator == "offset")
+                 bool(table.filters.any()), scene.settings.shadow_terminator == "offset",
+                 float(scene.settings.adc_bailout))
 
 
 def frames(max_depth: int) -> np.ndarray:

@@ -60,6 +60,7 @@ class Settings:
     total_internal_reflection: str = "drop"   # drop: the refracted weight is lost; reflect: to the mirror ray
     alpha: bool = False              # the background transparent, in the images that have alpha
     shadow_terminator: str = "none"  # none: feelers leave from the hit; offset: Hanika's shift on smooth faces
+    adc_bailout: float = 1e-6        # a secondary ray whose path weight is below this is not traced (0: all are)
 
     @contextlib.contextmanager
     def overridden(self, samples: int | None, max_depth: int | None):

@@ -24,7 +24,8 @@ from rtcli.core.jitter import sample_positions
 from rtcli.core.lights import COLOR, POSITION, attenuation, spot_factor
 from rtcli.core.scene import Scene
 from rtcli.errors import RtcliError
-from rtcli.inspect.raytree import Explanation, Feeler, Glass, Hit, LightSample, LightTerm, RayNode
+from rtcli.inspect.budget import MAX_NODES, Levels, Summary, deepest_shown
+from rtcli.inspect.raytree import Bailout, Explanation, Feeler, Glass, Hit, LightSample, LightTerm, RayNode
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import Rays, camera_rays
@@ -32,10 +33,11 @@ from rtcli.wavefront.trace import Log, trace
 
 
 class Recorder(Log):
-    """The engine's recorder (wavefront/trace.py) for one ray: fills a RayNode."""
+    """The engine's recorder (wavefront/trace.py) for one ray: fills a RayNode. Rays deeper than
+    `shown_to` (None: none) are summarised (budget.py)."""
 
-    def __init__(self, scene: Scene, node: RayNode):
-        self.scene, self.node = scene, node
+    def __init__(self, scene: Scene, node: RayNode, shown_to: int | None = None, left: list | None = None):
+        self.scene, self.node, self.shown_to, self.left = scene, node, shown_to, left
 
     def rays(self, rays: Rays, depth: int, hits) -> None:
         self.node.origin, self.node.direction = rays.o[:, 0].copy(), rays.d[:, 0].copy()
@@ -96,10 +98,20 @@ class Recorder(Log):
         self.node.glass = Glass(n1, n2, cos_i, theta_i, None if tir else math.degrees(math.asin(min(1.0, sin_t))),
                                 float(R[0]), tir, self.node.hit.coefficients["fresnel"])
 
-    def child(self, rows, kind: str, weights) -> Recorder:
+    def child(self, rows, kind: str, weights) -> Recorder | Summary:
+        if self.left is not None:                         # a first pass, given up past the budget
+            self.left[0] -= 1
+            if self.left[0] < 0:
+                raise OverBudget
         node = RayNode(kind, self.node.depth + 1, np.zeros(3), np.zeros(3), weights[:, 0].copy())
         self.node.children.append(node)
-        return Recorder(self.scene, node)
+        if self.shown_to is not None and node.depth > self.shown_to:
+            return Summary(node)
+        return Recorder(self.scene, node, self.shown_to, self.left)
+
+    def bailout(self, rows, kind: str, weights, path) -> None:
+        self.node.bailouts.append(Bailout(kind, weights[:, 0].copy(), path[:, 0].copy(),
+                                          self.scene.settings.adc_bailout))
 
     def color(self, color) -> None:
         self.node.value = color[:, 0].copy()
@@ -118,22 +130,38 @@ def coefficients(table, m: int) -> dict:
             "texture": type(mat.texture).__name__.lower() if mat.texture is not None else None}
 
 
-def trace_one(scene: Scene, x: float, y: float, width: int, height: int) -> RayNode:
-    """The tree of the primary ray through image position (x, y) of a width x height image."""
+def trace_one(scene: Scene, x: float, y: float, width: int, height: int, max_nodes: int = MAX_NODES) -> RayNode:
+    """The tree of the primary ray through image position (x, y) of a width x height image, its
+    rays past the node budget summarised (budget.py): when the whole tree does not fit, its rays
+    of each depth are counted first."""
     rays = camera_rays(scene.camera(width, height), np.array([x]), np.array([y]), width, height)
-    root = RayNode("primary", 1, rays.o[:, 0], rays.d[:, 0])
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        trace(scene, rays, 1, Stats(), log=Recorder(scene, root))
+        root = RayNode("primary", 1, rays.o[:, 0], rays.d[:, 0])
+        try:
+            trace(scene, rays, 1, Stats(), log=Recorder(scene, root, left=[max_nodes - 1]))
+            return root
+        except OverBudget:
+            pass
+        levels = Levels()
+        trace(scene, rays, 1, Stats(), log=levels)
+        root = RayNode("primary", 1, rays.o[:, 0], rays.d[:, 0])
+        trace(scene, rays, 1, Stats(), log=Recorder(scene, root, deepest_shown(levels.count, max_nodes)))
     return root
 
 
-def explain_pixel(model, x: int, y: int, width: int, height: int, gamma: bool = False) -> Explanation:
+class OverBudget(Exception):
+    """The tree has more rays than the budget: a first pass gives up."""
+
+
+def explain_pixel(model, x: int, y: int, width: int, height: int, gamma: bool = False,
+                  max_nodes: int = MAX_NODES) -> Explanation:
     """The ray trees of pixel (x, y) of a width x height image of a scene model readied for the numpy
-    engine, with its own samples and max_depth: one tree per sample, and the pixel their mean."""
+    engine, with its own samples and max_depth: one tree per sample, and the pixel their mean. Each
+    tree shows at most max_nodes rays in full, the deeper ones summarised."""
     settings = model.settings
     n = settings.samples
     xs, ys = sample_positions(np.array([x]), np.array([y]), n)
-    trees = [trace_one(model, float(xs[k, 0]), float(ys[k, 0]), width, height) for k in range(n * n)]
+    trees = [trace_one(model, float(xs[k, 0]), float(ys[k, 0]), width, height, max_nodes) for k in range(n * n)]
     value = np.array([t.value for t in trees]).reshape(n * n, 1, 3).mean(axis=0)     # as render_tile averages
     return Explanation(int(x), int(y), width, height, n, np.column_stack([xs[:, 0], ys[:, 0]]), trees, value[0],
                        to_8bit(value, gamma)[0], np.asarray(model.background, float), settings.specular, gamma)

@@ -43,6 +43,9 @@ def format_explanation(e, sample: int | None, style) -> str:
 def node_lines(node, style, cos_name: str = "R.V") -> list[str]:
     head = f"{node.kind} ray, depth {node.depth}: from {vec(node.origin)} along {vec(node.direction)}"
     out = [style(head, "ray")]
+    if node.more:
+        return out + [INDENT + style(f"… {node.more:,} more rays (this one and those below it, past the node "
+                                     f"budget: --max-nodes), total contribution {vec(node.contribution())}", "note")]
     if node.hit is None:
         out.append(INDENT + style(f"misses every object: the background {vec(node.value)}", "miss"))
         return out
@@ -66,6 +69,9 @@ def node_lines(node, style, cos_name: str = "R.V") -> list[str]:
         out.append(INDENT + style(glass_line(node.glass), "note"))
     if node.stopped:
         out.append(INDENT + style(f"max_depth {node.depth} reached: no reflected or refracted ray", "note"))
+    for cut in node.bailouts:
+        out.append(INDENT + style(f"{cut.kind} ray not traced: its path weight {vec(cut.path)} is below "
+                                  f"adc_bailout {num(cut.adc_bailout)}", "note"))
     parts = [f"local {vec(node.local())}"]
     for child in node.children:
         w = "wr" if child.kind == "reflected" else "wt"

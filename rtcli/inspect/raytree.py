@@ -113,6 +113,17 @@ class Glass:
 
 
 @dataclass
+class Bailout:
+    """A secondary ray not traced: its path weight (the product of the weights along its path) is
+    below the scene's adc_bailout in every channel (docs/scene-format.md, render)."""
+
+    kind: str                      # reflected or refracted
+    weight: Color                  # its wr or wt
+    path: Color                    # its path weight
+    adc_bailout: float
+
+
+@dataclass
 class RayNode:
     """A ray of the tree, what it hit and the terms of its color."""
 
@@ -130,6 +141,13 @@ class RayNode:
     children: list[RayNode] = field(default_factory=list)
     stopped: bool = False          # max_depth reached where the material would spawn rays
     value: Color | None = None     # the color the engine returned for this ray
+    bailouts: list[Bailout] = field(default_factory=list)   # secondary rays cut by adc_bailout
+    more: int = 0                  # > 0: a summarised ray (past explain's node budget), the rays of
+                                   # its subtree, itself included; only its weight and value are kept
+
+    def contribution(self) -> Color:
+        """What the ray adds to its parent's color: its weight times its color."""
+        return (1.0 if self.weight is None else self.weight) * self.total()
 
     def local(self) -> Color:
         """emission + ka Ia T + every light sample's diffuse and specular terms, in the engine's order."""
@@ -143,7 +161,7 @@ class RayNode:
     def total(self) -> Color:
         """The ray's color from the terms shown: the background on a miss, else local + each
         child's weight times its total."""
-        if self.hit is None:
+        if self.hit is None:                                    # a miss, or a summarised ray
             return np.array(self.value, dtype=float)
         color = self.local()
         for child in self.children:
@@ -160,7 +178,8 @@ class RayNode:
         return "\n".join(explain_text.node_lines(self, lambda text, role: text))
 
     def __repr__(self) -> str:
-        what = "misses" if self.hit is None else f"hits #{self.hit.object} {one_line(self.hit.name) or '(unnamed)'}"
+        what = (f"summarised, {self.more} rays" if self.more else "misses" if self.hit is None
+                else f"hits #{self.hit.object} {one_line(self.hit.name) or '(unnamed)'}")
         return f"<rtcli RayNode: {self.kind} ray, depth {self.depth}, {what}; print() shows its tree>"
 
     def _repr_pretty_(self, p, cycle: bool) -> None:
@@ -224,11 +243,13 @@ class Explanation:
 
 def _plain(value):
     """numpy and dataclasses as JSON's types."""
-    if isinstance(value, RayNode | Hit | Feeler | LightSample | LightTerm | Glass):
+    if isinstance(value, RayNode | Hit | Feeler | LightSample | LightTerm | Glass | Bailout):
         out = {k: _plain(v) for k, v in vars(value).items() if k != "terms"}
         if isinstance(value, RayNode) and value.hit is not None:
             out["local"] = _plain(value.local())
             out["total"] = _plain(value.total())
+        if isinstance(value, RayNode) and value.more:
+            out["contribution"] = _plain(value.contribution())
         if isinstance(value, Feeler):
             out["state"] = value.state
         return out

@@ -14,6 +14,8 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
+import time
+import weakref
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
@@ -32,6 +34,7 @@ from rtcli.wavefront.rays import camera_rays
 from rtcli.wavefront.trace import trace
 
 TILE = 128                                 # tile edge in pixels (rays per tile: TILE^2 x samples^2)
+PART_RAYS, PART_SECONDS = 256, 0.1         # the compiled engine's first part of a tile, and a part's time
 
 
 @dataclass(frozen=True)
@@ -67,7 +70,7 @@ def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
         xs, ys = sample_positions(i, j, scene.settings.samples)
         stats.primary += xs.size
         if engine:
-            colors = engine.trace_pixels(cam, xs.ravel(), ys.ravel(), job.width, job.height, stats)
+            colors = trace_in_parts(engine, cam, xs.ravel(), ys.ravel(), job, stats)
         else:
             colors = trace(scene, camera_rays(cam, xs.ravel(), ys.ravel(), job.width, job.height), 1, stats).T
     colors = colors.reshape(len(xs), len(i), 3)
@@ -87,6 +90,30 @@ def with_alpha(scene: Scene, cam, job: Job, xs: np.ndarray, ys: np.ndarray, colo
     count = hit.sum(axis=0)
     straight = np.where(hit[..., None], colors, 0.0).sum(axis=0) / np.maximum(count, 1)[:, None]
     return np.concatenate([straight, (count / hit.shape[0])[:, None]], axis=1)
+
+
+def trace_in_parts(engine, cam, x: np.ndarray, y: np.ndarray, job: Job, stats: Stats) -> np.ndarray:
+    """The compiled engine's colors (n, 3) of the rays through (x, y), traced a part at a time.
+
+    Python runs a signal's handler only between two of its own steps, never inside machine code,
+    so one call over a tile of minutes would hold Ctrl-C and SIGTERM back for minutes. Each part
+    takes about PART_SECONDS: its size follows the rays' measured speed (from PART_RAYS, and from
+    the engine's last part on its later tiles, which are then mostly one part each), so an
+    interrupt ends the render within a moment. Every ray's color depends on the ray alone: the
+    parts change no pixel."""
+    colors, start, size = np.empty((len(x), 3)), 0, _part_rays.get(engine, PART_RAYS)
+    while start < len(x):
+        began = time.perf_counter()
+        end = min(start + size, len(x))
+        colors[start:end] = engine.trace_pixels(cam, x[start:end], y[start:end], job.width, job.height, stats)
+        took = time.perf_counter() - began
+        size = max(PART_RAYS // 8, min(2 * size, int((end - start) * PART_SECONDS / took) if took > 0 else 2 * size))
+        start = end
+    _part_rays[engine] = size
+    return colors
+
+
+_part_rays: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()     # an engine's next part, in rays
 
 
 def _tiles(job: Job, samples: int = 1):

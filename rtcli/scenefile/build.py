@@ -112,6 +112,7 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
         settings.total_internal_reflection = r.choice("total_internal_reflection", ("drop", "reflect"), "drop")
         settings.alpha = r.boolean("alpha", False)
         settings.shadow_terminator = r.choice("shadow_terminator", ("none", "offset"), "none")
+        settings.adc_bailout = r.number("adc_bailout", settings.adc_bailout, non_negative=True)
         r.check_unused()
     camera, eye = camera_from(p.sub("camera"))
     check_resolvable(p, camera, settings.width, settings.height)

@@ -6,7 +6,10 @@
 
 wr and wt are the material's kr and kt, scaled by Fresnel's equations if it asks for them, and
 with kt moved to the mirror ray at total internal reflection if the scene asks for that
-(core/dielectric.py). Each branch recurses on the compacted subset of rays that need it. Every
+(core/dielectric.py). Adaptive depth control (docs/scene-format.md, render: adc_bailout): each ray
+carries its path weight, the product of the wr or wt of every surface before it (per channel,
+the primary's 1), and a secondary ray whose path weight is below adc_bailout in every channel is
+not traced. Each branch recurses on the compacted subset of rays that need it. Every
 ray carries the media it is inside (Media), for Snell's n1 / n2. Colors are (3, n).
 An optional recorder (`log`, a Log) is shown every quantity as it is computed and makes a
 recorder for each subset of secondary rays; it changes nothing it sees.
@@ -70,14 +73,18 @@ class Log:
     def child(self, rows: np.ndarray, kind: str, weights: np.ndarray) -> "Log | None":
         return self
 
+    def bailout(self, rows: np.ndarray, kind: str, weights: np.ndarray, path: np.ndarray) -> None:
+        """The reflected or refracted rays of `rows` not traced: their path weight is below adc_bailout."""
+
     def color(self, color: np.ndarray) -> None:
         """The color returned for each ray."""
 
 
 def trace(scene: Scene, rays: Rays, depth: int, stats: Stats, media: Media | None = None,
-          log: Log | None = None) -> np.ndarray:
-    """Color seen along each ray; depth 1 is the primary ray (in the scene's medium)."""
+          log: Log | None = None, path: np.ndarray | None = None) -> np.ndarray:
+    """Color seen along each ray; depth 1 is the primary ray (in the scene's medium, path weight 1)."""
     media = media or Media.none(scene.settings.max_depth, len(rays))
+    path = np.ones((3, len(rays))) if path is None else path
     color = np.repeat(np.asarray(scene.background, float)[:, None], len(rays), axis=1)
     hits = find_first_hit(scene, rays)
     seen = np.flatnonzero(np.isfinite(hits.t))
@@ -87,13 +94,14 @@ def trace(scene: Scene, rays: Rays, depth: int, stats: Stats, media: Media | Non
         s = surface(scene, rays[seen], hits[seen])
         if log:
             log.surface(seen, s)
-        color[:, seen] = shade(scene, rays[seen], s, depth, stats, media[seen], log and log.part(seen))
+        color[:, seen] = shade(scene, rays[seen], s, depth, stats, media[seen], log and log.part(seen), path[:, seen])
     if log:
         log.color(color)
     return color
 
 
-def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats, media: Media, log: Log | None = None) -> np.ndarray:
+def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats, media: Media, log: Log | None = None,
+          path: np.ndarray | None = None) -> np.ndarray:
     """rtShade: the local term plus the mirror and refracted rays (global term)."""
     color = local(scene, rays, s, stats, log)
     if depth >= scene.settings.max_depth:
@@ -112,14 +120,15 @@ def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats, media: Media, l
         wr[:, glass], wt[:, glass] = w_r, w_t
         if log:
             log.glass(glass, n1, n2, -dot(*D[:, glass], *s.n[:, glass]), R, tir)
-    mirror = np.flatnonzero(wr.max(axis=0) > 0)
+    path = np.ones((3, len(rays))) if path is None else path
+    mirror = followed(scene, wr, path, "reflected", log)
     if len(mirror):
         stats.reflected += len(mirror)
         ms = np.array(reflect(*D[:, mirror], *s.n[:, mirror]))      # ms = d - 2 (d.n) n
         reflected = trace(scene, Rays(s.p[:, mirror] + eps[:, mirror], ms), depth + 1, stats, media[mirror],
-                          log and log.child(mirror, "reflected", wr[:, mirror]))
+                          log and log.child(mirror, "reflected", wr[:, mirror]), path[:, mirror] * wr[:, mirror])
         color[:, mirror] += wr[:, mirror] * reflected
-    go = np.flatnonzero(wt[:, glass].max(axis=0) > 0) if len(glass) else glass
+    go = followed(scene, wt[:, glass], path[:, glass], "refracted", log, glass) if len(glass) else glass
     if len(go):
         rows = glass[go]
         stats.refracted += len(rows)
@@ -127,5 +136,18 @@ def shade(scene: Scene, rays: Rays, s, depth: int, stats: Stats, media: Media, l
         count = refracted_media(inside.ior, inside.count, table.ior[s.material[rows]], s.entering[rows], out_ior)
         rays_t = Rays(s.p[:, rows] - eps[:, rows], np.array(t_dir)[:, go])
         color[:, rows] += wt[:, rows] * trace(scene, rays_t, depth + 1, stats, Media(out_ior, count),
-                                              log and log.child(rows, "refracted", wt[:, rows]))
+                                              log and log.child(rows, "refracted", wt[:, rows]),
+                                              path[:, rows] * wt[:, rows])
     return color
+
+
+def followed(scene: Scene, w: np.ndarray, path: np.ndarray, kind: str, log: Log | None,
+             rows: np.ndarray | None = None) -> np.ndarray:
+    """Which of the secondary rays of weights w (3, n) are traced: those with w > 0 whose path weight
+    path x w is at least adc_bailout in some channel. The recorder is shown the others with w > 0."""
+    spawned = w.max(axis=0) > 0
+    kept = spawned & ((path * w).max(axis=0) >= scene.settings.adc_bailout)
+    if log and (spawned & ~kept).any():
+        cut = np.flatnonzero(spawned & ~kept)
+        log.bailout(cut if rows is None else rows[cut], kind, w[:, cut], path[:, cut] * w[:, cut])
+    return np.flatnonzero(kept)

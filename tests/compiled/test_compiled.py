@@ -190,6 +190,37 @@ def test_glass_media_fresnel_filtered_shadows(yaml_scene, tir, medium, bvh):
     assert sb.refracted > 2000 and len(np.unique(b.reshape(-1, 3), axis=0)) > 1500
 
 
+DEEP_GLASS = """
+camera: {eye: [0, 0, 4.5], look_at: [0, 0, 0], fov: 50}
+background: [0.3, 0.5, 0.8]
+render: {max_depth: DEPTH, adc_bailout: BAILOUT}
+lights: [{position: [2, 2.5, 3]}]
+materials:
+  glass: {diffuse: 0.1, reflection: 1, transmission: 1, ior: 1.5, fresnel: true}
+objects:
+  - {sphere: {center: [-1, 0, 0], radius: 0.9}, material: glass}
+  - {sphere: {center: [1, 0, 0], radius: 0.9}, material: glass}
+  - {sphere: {center: [0, 0, 0], radius: 6}, material: glass}
+"""
+
+
+@pytest.mark.parametrize("bailout", ["0.0039", "0.0005"])
+def test_deep_glass_with_adc_bailout_cuts_the_same_rays_in_both_engines(yaml_scene, bailout):
+    """Two glass balls inside a third, max_depth 64: without the cutoff the tree would have up to 2^63
+    rays a pixel. Both engines follow the same rays (their counts) and give the same bytes, and
+    the cutoff, not max_depth, ends every path: the same render at max_depth 40."""
+    deep = yaml_scene(DEEP_GLASS.replace("DEPTH", "64").replace("BAILOUT", bailout))
+    a, b, sa, sb = both(deep, 40, 30)
+    assert np.array_equal(a, b), f"{np.count_nonzero((a != b).any(axis=2))} pixels differ"
+    assert (sa.shadow, sa.reflected, sa.refracted) == (sb.shadow, sb.reflected, sb.refracted)
+    shallower = yaml_scene(DEEP_GLASS.replace("DEPTH", "40").replace("BAILOUT", bailout), "shallower.yaml")
+    c, sc = render(shallower, Job(40, 30, engine="compiled"))
+    assert np.array_equal(b, c) and (sc.reflected, sc.refracted) == (sb.reflected, sb.refracted)
+    unbounded = yaml_scene(DEEP_GLASS.replace("DEPTH", "10").replace("BAILOUT", "0"), "unbounded.yaml")
+    _, su = render(unbounded, Job(40, 30, engine="compiled"))
+    assert su.reflected > 2 * sb.reflected                # the cutoff cut: more rays at depth 10 without it
+
+
 def test_samples_max_depth_block_size_and_workers(yaml_scene):
     scene = yaml_scene(TRANSFORMED.replace("SPEC", "phong"))
     scene.settings.samples, scene.settings.max_depth = 2, 3

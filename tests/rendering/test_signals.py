@@ -17,11 +17,14 @@ import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
 
+import numpy as np
 import pytest
 from helpers import SLOW, scene_from_yaml
 
+from rtcli.kernels import variants
 from rtcli.errors import Interrupted
-from rtcli.rendering.tiles import Job, render
+from rtcli.rendering.tiles import PART_RAYS, PART_SECONDS, Job, render, trace_in_parts
+from rtcli.stats import Stats
 
 pytestmark = pytest.mark.skipif(not os.path.exists("/proc/self/task"), reason="needs Linux's /proc")
 
@@ -133,3 +136,62 @@ def test_ctrl_c_while_tiles_are_submitted_waits_until_every_tile_is(monkeypatch)
     finally:
         signal.signal(signal.SIGINT, previous)
     assert len(submitted) == 16
+
+
+HEAVY = """\
+image: {width: 1600, height: 1600}
+camera: {eye: [0, 2, 8], look_at: [0, 0, 0], fov: 50}
+render: {samples: 8, max_depth: 8}
+lights: [{position: [5, 8, 5], area: {u: [1, 0, 0], v: [0, 0, 1], samples: 4}}]
+objects:
+  - {plane: {}, material: {reflection: 0.5}}
+  - {sphere: {center: [-1.5, 1, 0]}, material: {reflection: 0.8}}
+  - {sphere: {center: [1.5, 1, 0]}, material: {transmission: 0.9, ior: 1.5}}
+  - {torus: {major: 1, minor: 0.3}, transform: [{translate: [0, 1, -2]}]}
+"""                                      # one tile of minutes with --engine compiled
+
+
+@pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")
+@pytest.mark.parametrize("target, signum, code, workers", [
+    ("group", signal.SIGTERM, 143, 1),
+    ("parent", signal.SIGINT, 130, 1),
+    ("parent", signal.SIGTERM, 143, 2),
+])
+def test_signal_stops_a_render_inside_one_long_compiled_tile(tmp_path, target, signum, code, workers):
+    """The whole image is one tile, traced in machine code, where Python cannot run a signal's
+    handler; the tile is traced in parts, so the render still ends at once."""
+    (tmp_path / "slow.yaml").write_text(HEAVY)
+    proc = subprocess.Popen([sys.executable, "-m", "rtcli", "render", "slow.yaml", "--engine", "compiled",
+                             "--tile", "4096", "--workers", str(workers), "-o", "out.png"],
+                            cwd=tmp_path, stderr=subprocess.PIPE, start_new_session=True)
+    time.sleep(4.0)                      # loaded (machine code, or numba's cache) and tracing the tile
+    assert proc.poll() is None, proc.stderr.read()
+    send = (lambda: os.killpg(proc.pid, signum)) if target == "group" else (lambda: os.kill(proc.pid, signum))
+    returncode, seconds, err = _stop(proc, send)
+    assert (returncode, err) == (code, "error: interrupted\n")
+    assert seconds < 5                   # a part takes about 0.1 s; without parts, the rest of the tile
+    _nothing_left(tmp_path, proc)
+
+
+class Engine:
+    """A compiled engine's stand-in: each ray's color from its coordinates, 20 µs a ray."""
+
+    def __init__(self):
+        self.parts = []
+
+    def trace_pixels(self, cam, x, y, nc, nr, stats):
+        self.parts.append(len(x))
+        time.sleep(20e-6 * len(x))
+        stats.primary += 0
+        stats.reflected += len(x)
+        return np.column_stack([x, y, x * nc + y])
+
+
+def test_a_compiled_tile_is_traced_in_parts_of_a_tenth_of_a_second():
+    engine, stats = Engine(), Stats()
+    x, y = np.arange(40_000) % 200 + 0.5, np.arange(40_000) // 200 + 0.5
+    colors = trace_in_parts(engine, None, x, y, Job(200, 200), stats)
+    np.testing.assert_array_equal(colors, np.column_stack([x, y, x * 200 + y]))
+    assert stats.reflected == 40_000 and sum(engine.parts) == 40_000 and engine.parts[0] == PART_RAYS
+    assert 5 < len(engine.parts) < 40 and max(engine.parts) <= 2 * PART_SECONDS / 20e-6
+    assert all(b <= 2 * a for a, b in zip(engine.parts, engine.parts[1:]))
