@@ -41,6 +41,7 @@ bench: warmup
 	-$(PY) -m pip install --quiet -e '.[bench]' || echo "the bench extra (mitsuba, embreex) did not install: timing without them"
 	$(PY) bench/run.py
 	$(PY) bench/rays.py
+	$(PY) bench/compile.py --runs 1
 
 clean:
 	rm -rf $(VENV) *.egg-info whitted.png
