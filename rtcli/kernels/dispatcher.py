@@ -6,6 +6,11 @@ as a literal of its value and compiles the callee, and everything it calls, once
 scene's hit dispatch was compiled six times over. Here a constant is typed as its type (int64)
 first, and as a literal only when the callee cannot be typed without it. Where the call is
 inlined (forceinline, docs/architecture.md), LLVM still folds the constant.
+
+A callee (a compiled variant only other kernels call, without Python's wrappers) gets no machine
+code of its own: its callers' libraries hold it (`_callee_machine_code`). This reaches into
+numba's code libraries (`numba.core.codegen`); with a numba whose internals differ it is left out,
+and numba generates the code as usual.
 """
 
 from __future__ import annotations
@@ -24,3 +29,43 @@ class Dispatcher(CPUDispatcher):
             return super().get_call_template(*plain)
         except errors.TypingError:              # a kernel that needs the constant to be typed
             return super().get_call_template(args, kws)
+
+
+CALLEE = ".callee"          # how a callee's name ends (variants._variant): numba names its code library so
+
+
+def _callee_machine_code(finalize):
+    """numba's last step of a code library (`_finalize_final_module`: the module to the JIT, which
+    generates its machine code), for a callee's library: the JIT gets a copy of the module whose
+    functions are `available_externally`, so it generates none of them, while callers link in the
+    module itself. No Python calls a callee (it has no wrapper), and every caller inlines or compiles
+    what it calls in its own library, so that machine code was made for nothing: 7.2 s of LLVM's
+    time in a cold compile of the render engine, 3.0 s without it."""
+    import llvmlite.binding as ll  # numba's
+
+    outside = (ll.Linkage.external, ll.Linkage.linkonce_odr)
+
+    def finalize_callee(self):
+        if not self.name.endswith(CALLEE):
+            return finalize(self)
+        kept = self._final_module
+        self._final_module = kept.clone()
+        for function in self._final_module.functions:
+            if not function.is_declaration and function.linkage in outside:
+                function.linkage = ll.Linkage.available_externally
+        try:
+            return finalize(self)
+        finally:
+            self._final_module = kept
+    return finalize_callee
+
+
+def _install() -> None:
+    from numba.core.codegen import JITCodeLibrary
+    finalize = getattr(JITCodeLibrary, "_finalize_final_module", None)
+    if finalize is not None and not getattr(finalize, "rtcli", False):
+        JITCodeLibrary._finalize_final_module = _callee_machine_code(finalize)
+        JITCodeLibrary._finalize_final_module.rtcli = True
+
+
+_install()
