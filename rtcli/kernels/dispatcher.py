@@ -60,12 +60,29 @@ def _callee_machine_code(finalize):
     return finalize_callee
 
 
+def _callee_optimisation(optimise):
+    """numba's optimisation of a code library's module with its callees linked in (O3's module
+    passes), for a callee's library: only numba's cheap pass (the inliner, which alwaysinline needs).
+    The module is linked into each caller and optimised there with O3 again, with the callee inlined
+    or beside it; the integrator's library, which is not a callee, gets the whole of O3 at the end."""
+    def optimise_callee(self):
+        if not self.name.endswith(CALLEE):
+            return optimise(self)
+        codegen = self._codegen
+        passes, builder = codegen._module_pass_manager(loop_vectorize=codegen._loopvect, slp_vectorize=False,
+                                                       opt=codegen._opt_level, cost="cheap")
+        passes.run(self._final_module, builder)
+    return optimise_callee
+
+
 def _install() -> None:
     from numba.core.codegen import JITCodeLibrary
-    finalize = getattr(JITCodeLibrary, "_finalize_final_module", None)
-    if finalize is not None and not getattr(finalize, "rtcli", False):
-        JITCodeLibrary._finalize_final_module = _callee_machine_code(finalize)
-        JITCodeLibrary._finalize_final_module.rtcli = True
+    for name, change in (("_finalize_final_module", _callee_machine_code),
+                         ("_optimize_final_module", _callee_optimisation)):
+        original = getattr(JITCodeLibrary, name, None)
+        if original is not None and not getattr(original, "rtcli", False):
+            setattr(JITCodeLibrary, name, change(original))
+            getattr(JITCodeLibrary, name).rtcli = True
 
 
 _install()
