@@ -35,11 +35,12 @@ test-all: warmup
 	$(PY) -m pytest -q
 
 golden: $(FULL)
-	$(PY) -m pytest -q tests/test_golden.py --update-goldens
+	$(PY) -m pytest -q tests/renders/test_golden.py --update-goldens
 
 bench: warmup
 	-$(PY) -m pip install --quiet -e '.[bench]' || echo "the bench extra (mitsuba, embreex) did not install: timing without them"
 	$(PY) bench/run.py
+	$(PY) bench/run.py --scenes million,torus1m
 	$(PY) bench/rays.py
 	$(PY) bench/compile.py --runs 1
 

@@ -8,6 +8,7 @@ for the command line. `rtcli.render` is the API's function; the tile renderer it
 drives is the module of the same name, imported as `from rtcli.rendering.tiles import ...`.
 """
 
+import importlib
 import sys
 import types
 
@@ -27,7 +28,6 @@ def __getattr__(name: str):
     """The API's names, imported when first asked for (PEP 562)."""
     if name not in _EXPORTS:
         raise AttributeError(f"module 'rtcli' has no attribute {name!r}")
-    import importlib
     value = getattr(importlib.import_module(_EXPORTS[name]), name)
     globals()[name] = value
     return value

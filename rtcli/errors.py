@@ -7,6 +7,7 @@ import re
 from dataclasses import dataclass
 
 _PLAIN = re.compile(r"[\w./+@%,=:~-]+", re.ASCII)       # shown without quotes
+_BYTE = re.compile(r"(?<!\\)((?:\\\\)*)\\udc([89a-f][0-9a-f])")   # repr's \udcXX: a byte that is not UTF-8
 SOURCES = ("<string>", "<dict>")     # how scenes given to the Python API as YAML text or a dict are named
 
 
@@ -26,8 +27,9 @@ class Where:
 
 def quoted(text) -> str:
     """Text from the user (a key, a name) in quotes, with every control or
-    non-printable character escaped (Python's repr), so it stays on one line."""
-    return repr(str(text))
+    non-printable character escaped (Python's repr), so it stays on one line; a byte of
+    a file name that is not UTF-8 (which Python holds as a lone surrogate) shows as \\xNN."""
+    return _BYTE.sub(r"\1\\x\2", repr(str(text)))
 
 
 def shown(text) -> str:
@@ -45,8 +47,13 @@ def plural(n: int, word: str, words: str | None = None) -> str:
 
 def one_line(message: str) -> str:
     """The message with any line break or other control character escaped: the last
-    guard of the rule that every error is one line."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
+    guard of the rule that every error is one line. A byte of a file name that is not
+    UTF-8 shows as \\xNN, so the line can be written as UTF-8."""
+    return "".join(c if c.isprintable() else _escaped(c) for c in message)
+
+
+def _escaped(c: str) -> str:
+    return f"\\x{ord(c) - 0xDC00:02x}" if "\udc80" <= c <= "\udcff" else repr(c)[1:-1]
 
 
 def error_line(error: BaseException) -> str:

@@ -6,12 +6,15 @@ Tests import them as `from helpers import ...` (pytest puts tests/ on the path).
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import numpy as np
 
+from rtcli.kernels import numba_cache
 from rtcli.rendering.tiles import Job, render_tile
 from rtcli.scenefile import yamlfile
 from rtcli.scenefile.load import scene_from_docs
@@ -68,3 +71,64 @@ def without_avx512(args: list[str], **kwargs) -> subprocess.CompletedProcess:
     done = subprocess.run([sys.executable, *args], env=env, capture_output=True, text=True, timeout=600, **kwargs)
     assert done.returncode == 0, done.stderr
     return done
+
+
+# a render that takes long enough to be interrupted: about 50 s on two cores with --engine numpy
+SLOW = """\
+image: {width: 320, height: 240}
+camera: {eye: [0, 2, 8], look_at: [0, 0, 0], fov: 50}
+render: {samples: 8, max_depth: 6}
+lights: [{position: [5, 8, 5], area: {u: [1, 0, 0], v: [0, 0, 1], samples: 4}}]
+objects:
+  - {plane: {}, material: {reflection: 0.5}}
+  - {sphere: {center: [-1.5, 1, 0]}, material: {reflection: 0.8}}
+  - {sphere: {center: [1.5, 1, 0]}, material: {transmission: 0.9, ior: 1.5}}
+  - {torus: {major: 1, minor: 0.3}, transform: [{translate: [0, 1, -2]}]}
+"""                                      # about 50 s on two cores with --engine numpy
+
+# numba's cache index files of two entry points, by the names numba gives them
+TRACE_CAMERA = "integrator.trace_camera-*.nbi"
+WALKS = "bvh.walk_rays_*.nbi"
+
+
+def seeded(root: Path, *without: str) -> Path:
+    """A cache folder laid out as numba lays out NUMBA_CACHE_DIR (a folder per source folder),
+    holding the warm cache's files but the index files matching `without` (those functions
+    compile there, loading the functions they call)."""
+    for d in numba_cache.COMPILED_DIRS:
+        source = Path(numba_cache.PACKAGE_DIR, d)
+        target = root / numba_cache.numba_subfolder(str(source))
+        target.mkdir(parents=True, exist_ok=True)
+        for f in (source / "__pycache__").glob("*"):
+            if f.suffix in (".nbi", ".nbc", ".sha256"):
+                shutil.copy2(f, target)
+    for pattern in without:
+        found = list(root.glob(f"*/{pattern}"))
+        assert found, pattern
+        for f in found:
+            f.unlink()
+    return root
+
+def image_summary(path, ignore=()) -> tuple:
+    """An image file's decoded pixels (mode, size, bytes) and its provenance without the render's
+    time and the keys in `ignore`: what two renders of one scene with the same settings agree on.
+    Their files differ by the time rtcli writes into them, so tests compare these, not bytes."""
+    from PIL import Image
+
+    from rtcli.rendering.reading import picture_meta
+    with Image.open(path) as img:
+        img.load()
+        meta = picture_meta(img)
+        frames = []
+        for k in range(getattr(img, "n_frames", 1)):             # every frame of a movie
+            img.seek(k)
+            frames.append(img.convert("RGB").tobytes() if k else img.tobytes())
+        summary = (img.mode, img.size, frames)
+    assert meta, f"{path}: no provenance"
+    dropped = {"rtcli.render_seconds", *(f"rtcli.{k}" for k in ignore)}
+    return summary, {k: v for k, v in meta.items() if k not in dropped}
+
+
+def same_image(a, b, ignore=()) -> bool:
+    """Whether two image files hold the same pixels and provenance (image_summary)."""
+    return image_summary(a, ignore) == image_summary(b, ignore)

@@ -20,7 +20,7 @@ import os
 from collections.abc import Callable
 
 from rtcli.api.loading import load
-from rtcli.api.options import check_options, image_size
+from rtcli.api.options import check_options, described, image_size
 from rtcli.api.pictures import Progress, render_scene, signature_scene
 from rtcli.api.results import ImageArray
 from rtcli.api.scene import Scene, Source
@@ -42,7 +42,7 @@ def load_scene(source: Source, *, width: int | None = None, height: int | None =
     YAML text or a dict are relative to `folder` (default: the current folder). `frame` picks
     the frame of an animated scene (default 1; `scene.at(k)` gives another).
     """
-    check_options(width=width, height=height, samples=samples, max_depth=max_depth, frame=frame)
+    check_options(width=width, height=height, samples=samples, max_depth=max_depth, frame=frame, folder=folder)
     scene = load(source, None if folder is None else os.fspath(folder), frame)
     return scene.override(width=width, height=height, samples=samples, max_depth=max_depth)
 
@@ -57,10 +57,12 @@ def _scene_of(scene: Scene | Source, frame: int | None) -> Scene:
 def render(scene: Scene | Source, *, width: int | None = None, height: int | None = None, samples: int | None = None,
            max_depth: int | None = None, engine: str = "auto", workers: int | None = None,
            block_size: int = 1, tile: int = TILE, gamma: bool = False, bvh: bool = True,
-           linear: bool = False, output: str | os.PathLike | None = None, progress: Progress | None = None,
+           linear: bool = False, alpha: bool | None = None, layers=(), bit_depth: int = 8, half: bool = False,
+           output: str | os.PathLike | None = None, progress: Progress | None = None,
            notes: Callable[[str], None] | None = None, frame: int | None = None) -> ImageArray:
     """Render a Scene (or what load_scene takes) to an ImageArray: uint8 (H, W, 3), or with
-    linear=True the float64 linear colors, unclamped.
+    linear=True the float64 linear colors, unclamped. alpha, layers, bit_depth and half: see
+    Scene.render (rtcli/api/pictures.py, render_scene) and docs/python-api.md.
 
     The options are the command line's: size (width or height alone keeps the aspect ratio),
     samples (n x n per pixel), max_depth, engine (auto, numpy or compiled), workers (processes;
@@ -75,7 +77,8 @@ def render(scene: Scene | Source, *, width: int | None = None, height: int | Non
     check_options(frame=frame)
     return render_scene(_scene_of(scene, frame), width=width, height=height, samples=samples, max_depth=max_depth,
                         engine=engine, workers=workers, block_size=block_size, tile=tile, gamma=gamma, bvh=bvh,
-                        linear=linear, output=output, progress=progress, notes=notes)
+                        linear=linear, alpha=alpha, layers=layers, bit_depth=bit_depth, half=half, output=output,
+                        progress=progress, notes=notes)
 
 
 def signature(scene: Scene | Source, *, width: int | None = None, height: int | None = None, block_size: int = 1,
@@ -94,8 +97,8 @@ def view(scene: Scene | Source, kind: str, *, width: int | None = None, height: 
     """The debug view `kind` (normal, depth, uv, albedo, bounces or ids; docs/debugging.md) of a
     Scene, or of what load_scene takes, at its size or the one given: an ImageArray of the view's
     data, which shows as its picture (rtcli/inspect/views.py)."""
-    if kind not in KINDS:
-        raise RtcliError(f"the view must be one of {', '.join(KINDS)}, got {kind!r}")
+    if not isinstance(kind, str) or kind not in KINDS:
+        raise RtcliError(f"the view must be one of {', '.join(KINDS)}, got {described(kind)}")
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if kind == "ids":
         return signature_scene(scene, width=width, height=height, workers=1)
@@ -111,7 +114,7 @@ def explain(scene: Scene | Source, x: int, y: int, *, width: int | None = None, 
             bvh: bool = True) -> Explanation:
     """The ray trees of pixel (x, y) (column from the left, row from the top) of a Scene, or of
     what load_scene takes; the size and settings as render takes them (docs/debugging.md)."""
-    check_options(width=width, height=height, samples=samples, max_depth=max_depth)
+    check_options(width=width, height=height, samples=samples, max_depth=max_depth, gamma=gamma, bvh=bvh)
     if not isinstance(scene, Scene):
         scene = load_scene(scene, width=width, height=height)
     w, h, _ = image_size(scene.model, width, height)

@@ -73,12 +73,12 @@ def _load(source: Source, folder: str | None, frame: int | None, option: str):
         tree, name = yamlfile.parse(source, "<string>", folder or "."), "<string>"
     elif isinstance(source, (str, os.PathLike)):
         if folder is not None:
-            raise TypeError("folder= is for YAML text and dicts; a scene file's names are relative to its folder")
+            raise RtcliError("folder= is for YAML text and dicts; a scene file's names are relative to its folder")
         path = os.fspath(source)
         loaded = load_file(path, frame, option=option, lint=True)
         return of_loaded(loaded, path), loaded.warnings
     else:
-        raise TypeError(f"a scene is a path, YAML text or a dict, not {type(source).__name__}")
+        raise RtcliError(f"a scene is a path, YAML text or a dict, not {type(source).__name__}")
     with reading_scene() as inputs, recording_remarks() as remarks:
         animation = Animation(yamlfile.load_tree(tree))
         k = frame or 1

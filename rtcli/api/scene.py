@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 
-from rtcli.api.options import check_options, image_size
+from rtcli.api.options import RANGES, check_options, image_size
 from rtcli.api.pictures import render_scene, signature_scene
 from rtcli.api.results import png_bytes
 from rtcli.errors import SOURCES, RtcliError, one_line, shown
@@ -47,6 +47,8 @@ class Scene:
 
     def at(self, frame: int) -> Scene:
         """The scene of another frame, with the same overrides (itself for its own frame)."""
+        if frame is None:                          # "not given" to check_options, but at() needs one
+            raise RtcliError("frame must be an integer in {}..{}, got None".format(*RANGES["frame"]))
         check_options(frame=frame)
         check_frame(self._animation, frame, self.source, "frame")
         if frame == self.frame:
@@ -58,6 +60,7 @@ class Scene:
     def override(self, width: int | None = None, height: int | None = None, samples: int | None = None,
                  max_depth: int | None = None) -> Scene:
         """Set the image size (width or height alone keeps the aspect ratio) and render settings; self."""
+        check_options(width=width, height=height, samples=samples, max_depth=max_depth)
         s = self.model.settings
         s.width, s.height, _ = image_size(self.model, width, height)
         s.samples, s.max_depth = samples or s.samples, max_depth or s.max_depth

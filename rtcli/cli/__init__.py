@@ -1,4 +1,4 @@
-"""The rtcli command line (README.md, Commands): render, signature, explain, compare, validate,
+"""The rtcli command line (README.md, Commands): render, signature, explain, compare, info, validate,
 preview, presets, warmup; one module a command, this one the group that wires them.
 
 Argument handling only: each command parses its options and calls the library. Errors from the
@@ -20,12 +20,13 @@ import click
 from rtcli import __version__
 from rtcli.cli.compare import compare
 from rtcli.cli.explain import explain
+from rtcli.cli.info import info
 from rtcli.cli.preview import preview
 from rtcli.cli.render import render
 from rtcli.cli.signature import signature
 from rtcli.cli.validate import presets, validate
 from rtcli.cli.warmup import warmup
-from rtcli.errors import Interrupted, RtcliError, error_line, one_line
+from rtcli.errors import Interrupted, RtcliError, error_line, one_line, shown
 
 
 def _on_signal(signum, frame):
@@ -44,12 +45,16 @@ class RtcliGroup(click.Group):
         extra.pop("standalone_mode", None)
         if not args:
             args = ["--help"]
+        if (why := _nul_argument(args)) is not None:
+            click.echo(f"error: {why}", err=True)
+            sys.exit(2)
         restore = _catch_signals()
         try:
             code = super().main(args, prog_name or "rtcli", standalone_mode=False, **extra)
         except click.exceptions.Exit as e:
             sys.exit(e.exit_code)
         except (Interrupted, click.exceptions.Abort) as e:
+            restore = _ignore_signals()                # the first signal decides; the exit is bounded
             if sys.stderr.isatty():
                 click.echo(err=True)                   # end the line the terminal's ^C is on
             click.echo("error: interrupted", err=True)
@@ -73,6 +78,29 @@ class RtcliGroup(click.Group):
             raise Interrupted(signal.SIGINT) from None
 
 
+def _nul_argument(args: list[str]) -> str | None:
+    """The message for the first argument holding a NUL byte, named by its option (no path, and
+    no other value rtcli takes, holds one; a shell cannot pass one, a program can), or None."""
+    for k, arg in enumerate(args):
+        if "\0" in arg:
+            option, _, value = arg.partition("=") if arg.startswith("--") and "=" in arg else ("", "", arg)
+            if not option and k and args[k - 1].startswith("-") and not arg.startswith("-"):
+                option = args[k - 1]
+            named = f"{shown(option)} " if option and "\0" not in option else ""
+            return f"{named}{shown(value)}: an argument cannot hold a NUL byte (a path cannot)"
+    return None
+
+
+def _ignore_signals():
+    """Ignore SIGINT and SIGTERM from now on (a process on its way out after the first: a later
+    one, a supervisor's SIGTERM to the group, would otherwise kill it by the default action half
+    way through its exit); returns the undo, which does nothing."""
+    if threading.current_thread() is threading.main_thread():
+        for s in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(s, signal.SIG_IGN)
+    return lambda: None
+
+
 def _catch_signals():
     """Turn SIGTERM into Interrupted (SIGINT is KeyboardInterrupt already); returns the undo."""
     if threading.current_thread() is not threading.main_thread():
@@ -93,5 +121,5 @@ def main(debug):
     # --debug is honoured by RtcliGroup.main, where errors arrive after click's context has closed.
 
 
-for _command in (render, signature, explain, compare, validate, preview, presets, warmup):
+for _command in (render, signature, explain, compare, info, validate, preview, presets, warmup):
     main.add_command(_command)

@@ -21,6 +21,18 @@ def not_empty(ctx, param, value):
     return value
 
 
+def layer_list(ctx, param, value):
+    """--layers: a comma-separated list of view kinds, each once, as a tuple."""
+    if value is None:
+        return ()
+    kinds = tuple(dict.fromkeys(k.strip() for k in value.split(",")))
+    unknown = [k for k in kinds if k not in VIEWS]
+    if unknown:
+        raise click.BadParameter(f"no layer {', '.join(map(repr, unknown))}: layers are {', '.join(VIEWS)}",
+                                 ctx, param)
+    return kinds
+
+
 def output_name(scene_path: str, out: str | None, suffix: str = ".png") -> str:
     """-o as given, or the scene's name with `suffix`, here."""
     return out or os.path.splitext(os.path.basename(scene_path))[0] + suffix

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import click
 
-from rtcli.cli.options import SIZE, VIEWS, cluster_options, not_empty, reach
+from rtcli.cli.options import SIZE, VIEWS, cluster_options, layer_list, not_empty, reach
 
 
 @dataclass(frozen=True)
@@ -45,6 +45,10 @@ class Options:
     cluster_file: str | None
     local_cluster: int | None
     watch: bool
+    bit_depth: str = "8"
+    half: bool = False
+    alpha: bool = False
+    layers: tuple = ()
 
     @property
     def several(self) -> bool:
@@ -67,6 +71,11 @@ class Options:
         return not self.quiet and (self.progress or sys.stderr.isatty())
 
     @property
+    def write(self) -> dict:
+        """How the images are written (ImageArray.stage's options)."""
+        return {"bit_depth": int(self.bit_depth), "half": self.half, "gamma": self.gamma}
+
+    @property
     def changes(self) -> dict:
         """The render settings the options change."""
         return {name: v for name, v in (("samples", self.samples), ("max_depth", self.max_depth)) if v}
@@ -79,6 +88,10 @@ def refused(o: Options) -> str | None:
     return next((why for bad, why in [
         (o.as_json and not o.stats, "--json goes with --stats"),
         (o.view and o.stats, "--stats counts the rays of a render, not of a --view"),
+        (o.view and (o.layers or o.half or o.bit_depth != "8" or o.alpha),
+         "--view writes an 8-bit picture: --layers, --half, --bit-depth and --alpha are for the render"),
+        (sequence and (o.layers or o.half or o.bit_depth != "8" or o.alpha),
+         "--layers, --half, --bit-depth and --alpha write still images, not frames or movies"),
         (several and (o.frame_range or o.movie or is_movie(o.output)),
          "--frames and movies render one animated scene, not several (--frame N renders frame N of each)"),
         (o.view and sequence and not several,
@@ -97,7 +110,7 @@ def refused(o: Options) -> str | None:
 @click.argument("scene_files", metavar="SCENE.yaml...", nargs=-1, required=True)
 @click.option("-o", "--output", metavar="OUT.png|DIR", callback=not_empty,
               help="Output image (default: the scene's name .png); the format follows the extension: "
-                   ".png, .jpg, .bmp, .tif, .webp or .ppm. Frames: a name with the frame number as %d "
+                   ".png, .jpg, .bmp, .tif, .webp or .ppm, or .exr and .pfm for the linear radiance as floats. Frames: a name with the frame number as %d "
                    "(out/frame_%04d.png); a movie: .apng or .gif. With several scenes or a folder: the "
                    "folder for their images, NAME.png each (default: here).")
 @click.option("--width", type=SIZE, help="Image width (the camera is kept).")
@@ -110,6 +123,14 @@ def refused(o: Options) -> str | None:
 @click.option("--tile", type=click.IntRange(1, 4096), default=128, show_default=True,
               help="Tile edge in pixels (memory per worker).")
 @click.option("--gamma", is_flag=True, help="sRGB-encode the output (default: linear).")
+@click.option("--bit-depth", type=click.Choice(["8", "16"]), default="8", show_default=True,
+              help="Bits per channel of a PNG or TIFF: 16 keeps the linear radiance's precision.")
+@click.option("--half", is_flag=True, help="An EXR's floats as float16 (default float32).")
+@click.option("--alpha", is_flag=True, help="The background transparent (as the scene's render: {alpha: true}): "
+                                            "PNG, TIFF, WebP or EXR.")
+@click.option("--layers", metavar="KIND,...", callback=layer_list,
+              help="Views to write as layers of the EXR beside the color: normal, depth, uv, albedo, bounces, "
+                   "ids (one ray a pixel; README.md, Images).")
 @click.option("--quiet", is_flag=True, help="No progress bar, no warnings.")
 @click.option("--progress", is_flag=True, help="Show the progress bar even when stderr is not a terminal.")
 @click.option("--stats", is_flag=True, help="Print rays traced by kind, time and rays per second.")

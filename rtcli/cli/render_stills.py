@@ -10,6 +10,7 @@ import time
 import click
 
 from rtcli import api
+from rtcli.api.layers import layers_of, meta_of, needs_floats
 from rtcli.api.loading import load_file
 from rtcli.api.results import ImageArray, RenderStats
 from rtcli.cli.options import check_size, load
@@ -20,7 +21,7 @@ from rtcli.inspect.views import summary
 from rtcli.rendering import batch
 from rtcli.rendering import watch as watching
 from rtcli.rendering.frames import has_image
-from rtcli.rendering.outputs import check_file_output
+from rtcli.rendering.outputs import check_file_output, check_format_options
 from rtcli.rendering.tiles import Job
 
 
@@ -30,7 +31,9 @@ def run(o, where, lint) -> list:
     items, folder = batch.plan(list(o.scene_files), o.output, f".{o.view}.png" if o.view else ".png")
     if o.skip_existing:
         items = missing(items, o.width, o.height)
-    current = {}
+    current, targets = {}, {item.scene: item.output for item in items}
+    for item in items:
+        check_format_options(item.output, layers=o.layers, alpha=o.alpha, **o.write)
 
     def load_one(path):
         current["loaded"], scene = load(path, o.frame, where is not None, lint, samples=o.samples,
@@ -38,7 +41,7 @@ def run(o, where, lint) -> list:
         return scene
 
     def render_one(scene, label, out=None):
-        return one_image(o, scene, label, out, folder, where, current.get("loaded"))
+        return one_image(o, scene, label, out, folder, where, current.get("loaded"), targets.get(scene.source))
     if o.watch:
         return watch_scene(items[0], load_one, render_one, o.stats, o.as_json)
     broken = []
@@ -46,15 +49,16 @@ def run(o, where, lint) -> list:
     def skip(item, error):
         broken.append(item)
         click.echo(batch.broken_line(item, error), err=True)
-    done = batch.run(items, folder, load_one, render_one, ids=o.view == "ids",
+    done = batch.run(items, folder, load_one, render_one, ids=o.view == "ids", write=o.write,
                      keep_going=skip if o.keep_going else None) if items else []
     for line in batch.stats_lines(done, o.as_json, folder is not None) if o.stats else ():
         click.echo(line)
     return broken
 
 
-def one_image(o, scene, label: str, out, folder, where, loaded):
-    """The image (or view) of one loaded scene; written to `out` when given (else by the caller)."""
+def one_image(o, scene, label: str, out, folder, where, loaded, target=None):
+    """The image (or view) of one loaded scene; written to `out` when given (else by the caller, to
+    `target`, as o.write says: the image is then linear when that output takes floats)."""
     check_size(scene.model, o.width, o.height)
     show = progress_bar(o.bar, one_line(label))
     if o.view:
@@ -62,12 +66,20 @@ def one_image(o, scene, label: str, out, folder, where, loaded):
         if out is not None:                               # --watch writes each view itself
             image.save(out)
         return image
+    alpha = o.alpha or scene.model.settings.alpha
+    check_format_options(out or target or "", layers=o.layers, alpha=alpha, **o.write)
+    floats = out is None and needs_floats(target, int(o.bit_depth))
     if where is not None:
-        return on_cluster(loaded, scene, where, o.changes, o.width, o.height, o.block_size, tile=o.tile,
-                          gamma=o.gamma, engine=o.engine, bvh=not o.no_bvh, progress=show)
+        image = on_cluster(loaded, scene, where, o.changes, o.width, o.height, o.block_size, tile=o.tile,
+                           gamma=o.gamma and not floats, engine=o.engine, bvh=not o.no_bvh, progress=show,
+                           linear=floats, alpha=alpha)
+        if o.layers:
+            image.layers = layers_of(scene, o.layers, image.shape[1], image.shape[0], o.tile, o.workers or 1)
+        return image
+    files = {"bit_depth": int(o.bit_depth), "half": o.half} if out is not None else {}    # --watch writes it
     return api.render(scene, width=o.width, height=o.height, engine=o.engine, workers=o.workers,
-                      block_size=o.block_size, tile=o.tile, gamma=o.gamma, bvh=not o.no_bvh, output=out,
-                      progress=show, notes=note)
+                      block_size=o.block_size, tile=o.tile, gamma=o.gamma and not floats, bvh=not o.no_bvh,
+                      linear=floats, alpha=alpha, layers=o.layers, output=out, progress=show, notes=note, **files)
 
 
 def on_cluster(loaded, scene, where, changes: dict, width, height, block_size, progress=None, **kw):
@@ -76,9 +88,11 @@ def on_cluster(loaded, scene, where, changes: dict, width, height, block_size, p
     start = time.perf_counter()
     pixels, counts = still(where, loaded, job, progress, changes)
     s = scene.model.settings
-    stats = RenderStats.of(job.width, job.height, 1 if job.signature else s.samples, counts,
-                           time.perf_counter() - start, start_up=False)
-    return ImageArray(pixels, stats, scene.inputs)
+    seconds = time.perf_counter() - start
+    stats = RenderStats.of(job.width, job.height, 1 if job.signature else s.samples, counts, seconds, start_up=False)
+    meta = meta_of(scene, job.width, job.height, block_size=block_size, gamma=job.gamma, alpha=job.alpha,
+                   content="ids" if job.signature else "color", engine=stats.engine, seconds=seconds)
+    return ImageArray(pixels, stats, scene.inputs, meta=meta)
 
 
 def watch_scene(item, load_one, render_one, stats: bool, as_json: bool) -> list:
@@ -121,4 +135,7 @@ def view(scene, kind: str, width, height, tile: int, label: str | None):
     map, which `rtcli compare --ids` reads (README.md, Commands)."""
     data = api.view(scene, kind, width=width, height=height, tile=tile)
     click.echo((f"{one_line(label)}: " if label else "") + summary(data, kind, scene.model.settings.max_depth))
-    return data if data.is_ids else ImageArray(data.to_8bit(), inputs=scene.inputs)
+    if data.is_ids:
+        return data
+    meta = meta_of(scene, data.shape[1], data.shape[0], content=f"view {kind}", engine="numpy")
+    return ImageArray(data.to_8bit(), inputs=scene.inputs, meta=meta)

@@ -46,7 +46,7 @@ def signature(scene_file, output, ids_out, legend, width, height, block_size, wo
         check_ids(scene)
         with where:
             ids = on_cluster(loaded, scene, where, {}, width, height, block_size, signature=True)
-    write_images([(out, signature_colors(ids))] + ([(ids_out, np.asarray(ids))] if ids_out else []))
+    write_images([(out, signature_colors(ids), ids.meta)] + ([(ids_out, np.asarray(ids), ids.meta)] if ids_out else []))
     if legend:
         click.echo(f"{'id':>5}  {'name':<24} {'shape':<10} {'pixels':>9}")
         for row in legend_rows(scene, ids):

@@ -41,7 +41,7 @@ class Told:
 def told() -> Told | None:
     """The notes of the worker running this task; None off a worker (the notes then go to stderr)."""
     try:
-        from distributed import get_worker
+        from distributed import get_worker  # the cluster extra: only on a worker
         return Told(get_worker())
     except (ImportError, ValueError):
         return None

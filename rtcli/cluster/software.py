@@ -3,12 +3,11 @@ with the client's when it connects and again in every task (for workers that joi
 
 from __future__ import annotations
 
-import hashlib
 import sys
-from pathlib import Path
 
 from rtcli import __version__
 from rtcli.errors import RtcliError
+from rtcli.rendering.provenance import sources_digest
 
 LIBRARIES = ("numpy", "numba", "llvmlite", "PIL", "yaml")
 
@@ -22,11 +21,7 @@ def fingerprint() -> dict:
     libraries' versions (numba's too: it decides the engine)."""
     global _fingerprint
     if _fingerprint is None:
-        package = Path(__file__).resolve().parent.parent
-        digest = hashlib.sha256()
-        for f in sorted(package.rglob("*.py")):
-            digest.update(str(f.relative_to(package)).encode() + b"\0" + f.read_bytes())
-        found = {"rtcli": f"{__version__} (sources {digest.hexdigest()[:12]})",
+        found = {"rtcli": f"{__version__} (sources {sources_digest()[:12]})",
                  "python": ".".join(map(str, sys.version_info[:3]))}
         for name in LIBRARIES:
             try:

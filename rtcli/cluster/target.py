@@ -3,10 +3,10 @@ LocalCluster started for the command; and Dask's connect timeout, which bounds t
 
 from __future__ import annotations
 
-import json
 import re
 from dataclasses import dataclass
 
+from rtcli.cluster.schedulerfile import scheduler_address
 from rtcli.errors import RtcliError, plural, shown
 
 INSTALL = "pip install -e '.[cluster]' in the rtcli folder (rtcli is not on the package index)"
@@ -36,7 +36,7 @@ def target(address: str | None, file: str | None, local: int | None) -> Target |
     if not given:
         return None
     if file:
-        address = _scheduler_address(file)
+        address = scheduler_address(file)
     if address:
         address = _checked_address(address, f"--cluster-file {shown(file)}: its address" if file else "--cluster")
     return Target(address, file, local or 0)
@@ -50,23 +50,9 @@ def _checked_address(address: str, what: str) -> str:
     return full
 
 
-def _scheduler_address(path: str) -> str:
-    """The address in a scheduler file (`dask scheduler --scheduler-file PATH` writes it)."""
-    try:
-        with open(path, encoding="utf-8") as f:
-            address = json.load(f).get("address")
-    except FileNotFoundError:
-        raise RtcliError(f"--cluster-file {shown(path)}: file not found") from None
-    except (OSError, ValueError, AttributeError) as e:
-        raise RtcliError(f"--cluster-file {shown(path)}: not a Dask scheduler file ({e})") from None
-    if not isinstance(address, str) or not address:
-        raise RtcliError(f"--cluster-file {shown(path)}: names no scheduler address")
-    return address
-
-
 def load_distributed():
     try:
-        import distributed
+        import distributed  # the cluster extra, optional: loaded when a command asks for a cluster
     except ImportError:
         raise RtcliError(f"a cluster needs Dask's distributed scheduler, which is not installed: {INSTALL}") \
             from None
@@ -75,6 +61,6 @@ def load_distributed():
 
 def connect_timeout() -> float:
     """Dask's connect timeout (distributed.comm.timeouts.connect), in seconds."""
-    import dask
+    import dask  # the cluster extra, optional: loaded when a command asks for a cluster
     from dask.utils import parse_timedelta
     return parse_timedelta(dask.config.get("distributed.comm.timeouts.connect"), "s")

@@ -63,7 +63,7 @@ def _checked(spec: dict) -> None:
 
 def _worker_address() -> str:
     try:
-        from distributed import get_worker
+        from distributed import get_worker  # the cluster extra: only on a worker
         return get_worker().address
     except (ImportError, ValueError):
         return "(unknown)"

@@ -13,8 +13,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rtcli.api.options import check_options, check_path
 from rtcli.api.results import ImageArray, png_bytes
 from rtcli.compare import images as gate
+from rtcli.core.display import to_8bit
 from rtcli.errors import RtcliError
 
 GATE = {"tolerance": 2, "max_bad_pixels": 16, "max_bad_fraction": 1e-4, "max_cluster": 3}
@@ -59,6 +61,7 @@ def diff(actual, expected, *, flip: bool = False, **options) -> Difference:
     unknown = set(options) - set(GATE) - set(ID_GATE)
     if unknown:
         raise TypeError(f"diff() got unknown options: {', '.join(sorted(unknown))}")
+    check_options(flip=flip, **options)
     a, e = pixels(actual, "actual"), pixels(expected, "expected")
     image_options = {k: options.get(k, v) for k, v in GATE.items()}
     id_options = {k: options.get(k, v) for k, v in ID_GATE.items()}
@@ -74,13 +77,12 @@ def diff(actual, expected, *, flip: bool = False, **options) -> Difference:
 def pixels(image, name: str = "image") -> np.ndarray:
     """An image as compare.py takes it: uint8 (H, W, 3) or an integer (H, W) id map."""
     if isinstance(image, (str, os.PathLike)):
-        return gate.read_png(os.fspath(image))
+        return gate.read_png(check_path(name, image))
     if hasattr(image, "mode") and hasattr(image, "size"):           # a Pillow image
         return np.asarray(image if image.mode in ("RGB", "L", "I", "I;16") else image.convert("RGB"))
     array = np.asarray(image)
     if array.dtype.kind == "f":
         if array.ndim != 3 or array.shape[2] != 3:
             raise RtcliError(f"{name} is not an RGB image (H, W, 3): got {array.dtype} array of shape {array.shape}")
-        from rtcli.core.display import to_8bit
         return to_8bit(array)
     return array

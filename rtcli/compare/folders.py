@@ -1,8 +1,10 @@
 """`rtcli compare ACTUAL_DIR EXPECTED_DIR`: images paired by relative path, the gate per pair.
 
-Every .png under either folder (subfolders too) is paired with the file of the same
-relative path under the other. Each pair goes through compare.py's gate, as `rtcli
-compare` on two files does (a color image, or a 16-bit signature id map). A pair
+Every .png, .exr and .pfm under either folder (subfolders too) is paired with the file
+of the same relative path under the other. Each pair goes through compare.py's gate, as
+`rtcli compare` on two files does (a color image, or a 16-bit signature id map; float
+images and an EXR's id layer by floats.py), and its notes say when the two images' provenance
+differs (other settings, another rtcli). A pair
 is ok, failing, missing (no actual image for an expected one), extra (an actual
 image without an expected one) or unreadable (a file that is not a readable PNG);
 anything but ok fails the run. An unreadable file fails its pair, not the run, so
@@ -22,8 +24,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from rtcli.compare import images as gate
+from rtcli.compare.floats import compare_any, read_image
 from rtcli.errors import RtcliError, one_line, plural, shown
+from rtcli.rendering.provenance import differences
 
+IMAGES = (".png", ".exr", ".pfm")
 RANK = {"unreadable": 0, "missing": 1, "extra": 2, "failing": 3, "ok": 4}      # worst first
 ERRORS = ("unreadable", "missing")                # not compared; the other statuses but ok are failures
 
@@ -38,6 +43,7 @@ class Pair:
     comparison: gate.Comparison | None = None
     seconds: float = 0.0
     flip_mean: float | None = None
+    notes: tuple[str, ...] = ()                # provenance.differences: other settings, another rtcli
 
     @property
     def ok(self) -> bool:
@@ -55,14 +61,15 @@ class Pair:
 
 
 def images_under(folder: str) -> dict[str, str]:
-    """relative path (with /) -> path of every .png under `folder`, skipping rtcli's temporary files."""
+    """relative path (with /) -> path of every image (IMAGES) under `folder`, skipping rtcli's temporary
+    files."""
     if not os.path.isdir(folder):
         raise RtcliError(f"{shown(folder)}: not a folder (give two folders, or two images)")
     found = {}
     for root, dirs, files in os.walk(folder):
         dirs.sort()
         for name in files:
-            if name.lower().endswith(".png") and not name.startswith(".rtcli-"):
+            if name.lower().endswith(IMAGES) and not name.startswith(".rtcli-"):
                 path = os.path.join(root, name)
                 found[os.path.relpath(path, folder).replace(os.sep, "/")] = path
     return found
@@ -74,7 +81,7 @@ def compare_folders(actual_dir: str, expected_dir: str, image_options: dict, id_
     decoded pixels (None where absent or unreadable) of each, for a report."""
     actual, expected = images_under(actual_dir), images_under(expected_dir)
     if not actual and not expected:
-        raise RtcliError(f"no .png images under {shown(actual_dir)} or {shown(expected_dir)}")
+        raise RtcliError(f"no .png, .exr or .pfm images under {shown(actual_dir)} or {shown(expected_dir)}")
     pairs = []
     for index, path in enumerate(sorted(set(actual) | set(expected))):
         start = time.perf_counter()
@@ -82,23 +89,24 @@ def compare_folders(actual_dir: str, expected_dir: str, image_options: dict, id_
         if keep is not None:
             pair = keep(index, pair, a, e) or pair
         pairs.append(Pair(pair.path, pair.status, pair.summary, pair.comparison,
-                          time.perf_counter() - start, pair.flip_mean))
+                          time.perf_counter() - start, pair.flip_mean, pair.notes))
     return pairs
 
 
 def _compare_one(path, actual, expected, image_options, id_options):
     a = e = None
     try:
-        a = gate.read_png(actual) if actual else None
-        e = gate.read_png(expected) if expected else None
+        a = read_image(actual) if actual else None
+        e = read_image(expected) if expected else None
     except RtcliError as error:
         return Pair(path, "unreadable", f"UNREADABLE: {one_line(str(error))}"), a, e
     if a is None:
         return Pair(path, "missing", f"MISSING: no actual image for {shown(expected)}"), a, e
     if e is None:
         return Pair(path, "extra", f"EXTRA: no expected image for {shown(actual)}"), a, e
-    result = gate.compare(a, e, image_options, id_options)
-    return Pair(path, "ok" if result.ok else "failing", result.summary, result), a, e
+    result = compare_any(a, e, image_options, id_options)
+    notes = tuple(differences(a.meta, e.meta))
+    return Pair(path, "ok" if result.ok else "failing", result.summary, result, notes=notes), a, e
 
 
 def counts(pairs: list[Pair]) -> dict[str, int]:

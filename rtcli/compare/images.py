@@ -21,12 +21,15 @@ Every comparison yields a one-line summary starting with "OK:" or "FAIL:".
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from PIL import Image
 from scipy import ndimage
 
 from rtcli.errors import RtcliError, plural, shown
+from rtcli.scenefile.files import InputError, check_input
 
 _EIGHT = np.ones((3, 3), dtype=int)     # 8-connectivity for ndimage.label
 
@@ -201,11 +204,15 @@ def heat_map(actual, expected, tolerance: int = 2) -> np.ndarray:
         raise RtcliError(differs.summary.removeprefix("FAIL: "))
     out = np.empty(actual.shape, dtype=np.uint8)
     for y in range(0, actual.shape[0], BAND):
-        e = _band_errors(actual[y:y + BAND], expected[y:y + BAND])[0].astype(np.int32)
-        t = np.where(e > 0, np.minimum(255, 32 + 8 * e), 0)
-        t = np.where(e > tolerance, np.maximum(t, 128), t)
-        out[y:y + BAND] = np.clip(3 * t[..., None] - np.array([0, 255, 510], np.int32), 0, 255)
+        out[y:y + BAND] = ramp(_band_errors(actual[y:y + BAND], expected[y:y + BAND])[0].astype(np.int32), tolerance)
     return out
+
+
+def ramp(e: np.ndarray, tolerance: int) -> np.ndarray:
+    """The heat map's colors (see heat_map) of per-pixel errors e (integers 0..255)."""
+    t = np.where(e > 0, np.minimum(255, 32 + 8 * e), 0)
+    t = np.where(e > tolerance, np.maximum(t, 128), t)
+    return np.clip(3 * t[..., None] - np.array([0, 255, 510], np.int32), 0, 255).astype(np.uint8)
 
 
 def read_png(path) -> np.ndarray:
@@ -217,11 +224,7 @@ def read_png(path) -> np.ndarray:
     a comparison holds both images (3 bytes per pixel each) and a few bytes per pixel
     more, about 500 MB at the limit with --diff.
     """
-    import warnings
 
-    from PIL import Image
-
-    from rtcli.scenefile.files import InputError, check_input
     try:
         check_input(path, 1 << 40)
         with warnings.catch_warnings():
@@ -254,7 +257,7 @@ def flip_map(actual: np.ndarray, expected: np.ndarray) -> tuple[np.ndarray, floa
     Needs the optional flip-evaluator package (`pip install -e '.[flip]'` in the rtcli folder).
     """
     try:
-        import flip_evaluator
+        import flip_evaluator  # the flip extra, optional: only for --metric flip
     except ImportError:
         raise RtcliError("--flip needs the flip-evaluator package: pip install -e '.[flip]' in the rtcli "
                          "folder (rtcli is not on the package index)") from None

@@ -1,8 +1,10 @@
 """The HTML report of `rtcli compare ACTUAL_DIR EXPECTED_DIR --report DIR`, one row per pair, worst first.
 
 DIR/index.html shows for each pair the actual and expected images, the heat map of
-their difference (compare.heat_map; for id maps, the pixels whose ids differ), NVIDIA
-FLIP's error map when flip-evaluator is installed, and the summary numbers. The
+their difference (compare.heat_map; for id maps, the pixels whose ids differ; float images
+shown clamped, their heat map in units of the float tolerance), NVIDIA FLIP's error map
+when flip-evaluator is installed (8-bit pairs), the summary numbers, and the notes on how
+the two images were made when that differs. The
 pictures are PNGs in DIR/images/, so the folder is the whole report (CI uploads it as
 it is); the page loads nothing else and needs no script to read (one small script
 marks a picture that failed to load). It is built in a temporary folder beside DIR
@@ -21,6 +23,7 @@ import tempfile
 import numpy as np
 from PIL import Image
 
+from rtcli.compare import floats
 from rtcli.compare import images as gate
 from rtcli.compare.folders import Pair, comparable
 from rtcli.compare.report_html import page
@@ -52,8 +55,9 @@ def check_report_dir(path: str, folders: list[str]) -> None:
 class Report:
     """A report being built: keep() writes each pair's pictures, finish() the page, place() moves it in."""
 
-    def __init__(self, path: str, tolerance: int, titles: tuple[str, str]):
+    def __init__(self, path: str, tolerance: int, titles: tuple[str, str], float_tolerance: float = 0.01):
         self.path, self.tolerance, self.titles = path, tolerance, titles
+        self.float_tolerance = float_tolerance
         self.flip = importlib.util.find_spec("flip_evaluator") is not None
         self.tmp = tempfile.mkdtemp(prefix=".rtcli-report-", dir=os.path.dirname(os.path.abspath(path)))
         os.mkdir(os.path.join(self.tmp, "images"))
@@ -62,7 +66,11 @@ class Report:
     def keep(self, index: int, pair: Pair, a: np.ndarray | None, e: np.ndarray | None) -> Pair:
         """Write the pair's pictures; returns the pair with FLIP's mean error when it was computed."""
         shown_pictures = {"actual": a, "expected": e}
-        if comparable(a, e):
+        if _floats(a, e):
+            shown_pictures = {"actual": floats.shown(a), "expected": floats.shown(e)}
+            if a.shape[:2] == e.shape[:2]:
+                shown_pictures["difference"] = floats.heat_map_floats(a, e, self.float_tolerance)
+        elif comparable(a, e):
             shown_pictures["difference"] = gate.heat_map(a, e, self.tolerance)
             if self.flip:
                 shown_pictures["flip"], mean = gate.flip_map(a, e)
@@ -71,6 +79,8 @@ class Report:
             shown_pictures["difference"] = np.where((a != e)[..., None], np.uint8(255), np.uint8(0)).repeat(3, 2)
         names = {}
         for column, pixels in shown_pictures.items():
+            if pixels is not None and pixels.dtype.kind == "f":
+                pixels = floats.shown(pixels)                       # one float image of an odd pair
             if pixels is not None:
                 names[column] = f"images/{index + 1:04d}-{column}.png"
                 _save(os.path.join(self.tmp, names[column]), pixels)
@@ -80,7 +90,7 @@ class Report:
     def finish(self, pairs: list[Pair], gate_text: str) -> None:
         rows = sorted(pairs, key=Pair.severity)
         text = page(rows, self.pictures, self.titles, gate_text, self.flip)
-        with open(os.path.join(self.tmp, "index.html"), "w", encoding="utf-8") as f:
+        with open(os.path.join(self.tmp, "index.html"), "w", encoding="utf-8", errors="backslashreplace") as f:
             f.write(text)
         open(os.path.join(self.tmp, MARKER), "w").close()
 
@@ -97,6 +107,11 @@ class Report:
 
     def discard(self) -> None:
         shutil.rmtree(self.tmp, ignore_errors=True)
+
+
+def _floats(a: np.ndarray | None, e: np.ndarray | None) -> bool:
+    """Whether both images of a pair are float images (EXR, PFM)."""
+    return a is not None and e is not None and a.dtype.kind == "f" and e.dtype.kind == "f"
 
 
 def _save(path: str, pixels: np.ndarray) -> None:

@@ -1,7 +1,8 @@
 """The page of a comparison report (report.py): one table row per pair, in the order given.
 
 Plain HTML with its style inline: it loads only the pictures beside it. Every text
-from outside (paths, summaries) is escaped. Rows carry the class `pair`, their status
+from outside (paths, summaries) is kept on one line, a byte of a file name that is not
+UTF-8 shown as \\xNN (errors.one_line), and escaped. Rows carry the class `pair`, their status
 and, unless ok, their result (`error`: not compared, such as a golden without a render,
 shown with the golden; `failure`), so a reader (or a test in a browser) can count them; a small script marks a
 picture that did not load with the class `broken` and counts those that did in the
@@ -13,6 +14,7 @@ from __future__ import annotations
 from html import escape
 
 from rtcli.compare.folders import Pair, total_line
+from rtcli.errors import one_line
 
 STYLE = """
 body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em; color: #222; }
@@ -27,6 +29,7 @@ img.broken { outline: 3px solid #d00; min-width: 40px; min-height: 30px; }
 .error .status { background: #d06000; }
 .result { margin-left: 4px; font-size: 12px; color: #555; }
 .total { font-weight: bold; }
+.note { font-size: 12px; max-width: 24em; color: #6a4a00; background: #fff4d6; padding: 2px 4px; margin-top: 4px; }
 """
 
 LOADED = """
@@ -46,7 +49,7 @@ def page(rows: list[Pair], pictures: dict, titles: tuple[str, str], gate_text: s
     columns = ["actual", "expected", "difference"] + (["flip"] if flip else [])
     head = "".join(f"<th>{escape(c if c != 'flip' else 'FLIP')}</th>" for c in columns)
     body = "\n".join(_row(k, pair, pictures.get(pair.path, {}), columns) for k, pair in enumerate(rows, 1))
-    actual, expected = (escape(t) for t in titles)
+    actual, expected = (_text(t) for t in titles)
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <title>rtcli compare: {actual} against {expected}</title>
@@ -70,13 +73,19 @@ actual one, such as a scene that failed to render, or an unreadable file), then 
 def _row(k: int, pair: Pair, names: dict, columns: list[str]) -> str:
     cells = "".join(_cell(names.get(c), c, pair.path) for c in columns)
     flip = f"<div>mean FLIP {pair.flip_mean:.4f}</div>" if pair.flip_mean is not None else ""
+    flip += "".join(f'<div class="note">{escape(note)}</div>' for note in pair.notes)
     kind, result = ("", "") if pair.ok else (f" {pair.result}", f'<span class="result">{pair.result}</span>')
-    return (f'<tr class="pair {pair.status}{kind}" id="pair-{k}"><td><div class="path">{escape(pair.path)}</div>'
+    return (f'<tr class="pair {pair.status}{kind}" id="pair-{k}"><td><div class="path">{_text(pair.path)}</div>'
             f'<span class="status">{escape(pair.status)}</span>{result}'
-            f'<div class="summary">{escape(pair.summary)}</div>{flip}</td>{cells}</tr>')
+            f'<div class="summary">{_text(pair.summary)}</div>{flip}</td>{cells}</tr>')
 
 
 def _cell(name: str | None, column: str, path: str) -> str:
     if name is None:
         return "<td>-</td>"
-    return f'<td><a href="{name}"><img src="{name}" alt="{escape(column)} of {escape(path)}"></a></td>'
+    return f'<td><a href="{name}"><img src="{name}" alt="{escape(column)} of {_text(path)}"></a></td>'
+
+
+def _text(text: str) -> str:
+    """Text from outside (a path, a summary) for the page: on one line, every byte shown, escaped."""
+    return escape(one_line(text))

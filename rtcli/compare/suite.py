@@ -14,21 +14,25 @@ import time
 from collections.abc import Callable
 
 from rtcli.compare.folders import compare_folders, images_under, total_line
+from rtcli.compare.junit import junit_xml, write_junit
+from rtcli.compare.report import Report, check_report_dir
 from rtcli.errors import RtcliError, shown
+from rtcli.rendering.outputs import check_file_output
 
 
 def compare_dirs(actual: str, expected: str, image_options: dict, id_options: dict, report: str | None,
                  junit: str | None, echo: Callable[[str], None]) -> bool:
     """Compare the folders, print the lines, write the outputs; whether every pair passed."""
-    from rtcli.compare.junit import junit_xml, write_junit
-    from rtcli.compare.report import Report
     _check_outputs(actual, expected, report, junit)
     start = time.perf_counter()
-    built = Report(report, image_options["tolerance"], (actual, expected)) if report else None
+    built = Report(report, image_options["tolerance"], (actual, expected),
+                   image_options.get("float_tolerance", 0.01)) if report else None
     try:
         pairs = compare_folders(actual, expected, image_options, id_options, built.keep if built else None)
         for pair in pairs:
             echo(f"{shown(pair.path)}: {pair.summary}")
+            for note in pair.notes:
+                echo(f"  {note}")
         echo(total_line(pairs))
         if built:
             built.finish(pairs, gate_text(image_options, id_options))
@@ -59,8 +63,6 @@ def are_folders(actual: str, expected: str) -> bool:
 
 
 def _check_outputs(actual: str, expected: str, report: str | None, junit: str | None) -> None:
-    from rtcli.compare.report import check_report_dir
-    from rtcli.rendering.outputs import check_file_output
     inputs = list(images_under(actual).values()) + list(images_under(expected).values())
     if report:
         check_report_dir(report, [actual, expected])
@@ -74,7 +76,8 @@ def _check_outputs(actual: str, expected: str, report: str | None, junit: str | 
 def gate_text(image_options: dict, id_options: dict) -> str:
     """The gate in words, for the report's header."""
     o, i = image_options, id_options
-    return (f"a pixel is bad beyond {o['tolerance']}/255 in a channel; a pair fails with more than "
+    floats = f" ({o.get('float_tolerance', 0.01):g} x max(1, expected) in linear floats)"
+    return (f"a pixel is bad beyond {o['tolerance']}/255{floats} in a channel; a pair fails with more than "
             f"max({o['max_bad_pixels']}, {o['max_bad_fraction']:g} of the pixels) bad pixels or a cluster "
             f"of more than {o['max_cluster']}; id maps allow max({i['max_boundary_mismatch']}, "
             f"{i['max_boundary_fraction']:g} of the boundary) mismatches on id boundaries, none elsewhere")

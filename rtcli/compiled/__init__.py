@@ -3,7 +3,7 @@
 numpy's throughput on arrays bounds the wavefront engine (rtcli/wavefront/) at
 about 1.4 ns per element-operation, with dozens of operations per ray and bounce.
 This package runs the same integrator one ray at a time, compiled, on the same
-kernels (rtcli/kernels/variants.py), and gives the same pixels (tests/test_compiled.py
+kernels (rtcli/kernels/variants.py), and gives the same pixels (tests/compiled/test_compiled.py
 renders every supported scene both ways). Which engine renders a job is decided in one
 place, rtcli/rendering/engine.py, from what this package says: what it cannot render
 (pack.unsupported), why it cannot start (why_not), whether it starts at once or its code is
@@ -31,12 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rtcli.kernels import numba_cache, variants
+from rtcli.compiled.build import runner
 from rtcli.compiled.loading import Load, cached, ready, say
 from rtcli.compiled.pack import frames, geometry, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
-from rtcli.kernels import machinecode
+from rtcli.kernels import machinecode, numba_cache, variants
 from rtcli.stats import Stats
 
 __all__ = ["Compiled", "Load", "ready_to_load", "starts_at_once", "unsupported", "why_not"]
@@ -51,7 +51,7 @@ class Compiled:
 
     def __init__(self, scene, bvh: bool = True, notes=None, start: float | None = None):
         start = time.perf_counter() if start is None else start
-        self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh)
+        self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh, levels=runner())
         self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
         self.frames = frames(self.looks.max_depth)
         nowhere, none = Camera(*np.zeros((4, 3))), np.zeros(0)
@@ -99,6 +99,8 @@ ENTRY = "trace_camera"
 
 
 def compiled_integrator():
+    # start-up: the integrator's module compiles its dispatch with numba when imported, which a
+    # render from the machine code files never loads
     from rtcli.compiled.integrator import trace_camera
     return variants.compiled(trace_camera)
 

@@ -7,9 +7,8 @@ from __future__ import annotations
 
 import sys
 
-from rtcli.kernels import variants
 from rtcli.core.bvh_build import levels, levels_build
-from rtcli.kernels import machinecode
+from rtcli.kernels import machinecode, variants
 
 LEVELS = "levels"                 # the machine code file of `levels` (rtcli/kernels/machinecode)
 

@@ -36,9 +36,10 @@ from rtcli.compiled.pack import (
     XFORM,
     D,
     N,
+    SMOOTH_KINDS,
     P,
 )
-from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, material_of, scene_hit
+from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, leaf_point, material_of, scene_hit
 from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.camera import primary_ray
 from rtcli.core.dielectric import FEELER_CROSSINGS, fresnel, indices, refracted_media, split
@@ -46,9 +47,10 @@ from rtcli.core.lights import COLOR, sample_point, toward, weight
 from rtcli.core.shading import ambient, diffuse, facing, specular, specular_cos
 from rtcli.core.textures import IMAGE, NONE, texture_color
 from rtcli.core.textures import KIND as TEXTURE_KIND
-from rtcli.core.transform import normal_to_world, ray_to_object
+from rtcli.core.transform import WORLD, linear, normal_to_world, ray_to_object
 from rtcli.core.vec import dot, reflect, refract, unit
 from rtcli.kernels.variants import per_ray
+from rtcli.shapes.triangle import terminator
 
 SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
 
@@ -75,16 +77,34 @@ def surface(g, k, prim, t, ox, oy, oz, dx, dy, dz):
 
 @per_ray(inline=True)
 def texture_at(g, s, m, k, prim, px, py, pz):
-    """T at the object-space point: the shape's (u, v) are worked out for image textures only."""
+    """T at the object-space point (a csg's: its leaf's own space): the shape's (u, v) are worked out
+    for image textures only."""
     tex = s.texture[m]
     if tex[TEXTURE_KIND] == NONE:
         return 1.0, 1.0, 1.0
     u, v = 0.0, 0.0
-    if tex[TEXTURE_KIND] == IMAGE and g.ints[k, KIND] == CSG_KIND:
-        u, v = csg_uv(g, prim, px, py, pz)
+    if g.ints[k, KIND] == CSG_KIND:
+        if tex[TEXTURE_KIND] == IMAGE:
+            u, v = csg_uv(g, prim, px, py, pz)
+        px, py, pz = leaf_point(g, prim % len(g.leaves), px, py, pz)     # as CSG.texture_points
     elif tex[TEXTURE_KIND] == IMAGE:
         u, v = UV_ANY(g.ints[k, KIND], g.objects[k], g.pool, prim, px, py, pz)
     return texture_color(tex, s.texels, px, py, pz, u, v)
+
+
+@per_ray(inline=True)
+def feeler_base(g, s, k, prim, px, py, pz, qx, qy, qz):
+    """Where the feelers of a hit leave from (less the offset): the hit p, or with shadow_terminator:
+    offset on a smooth triangle or mesh, p plus the `terminator` shift at the object-space point q
+    taken to world space (as wavefront.intersect.lifts)."""
+    kind = g.ints[k, KIND]
+    if not s.terminator or (kind != SMOOTH_KINDS[0] and kind != SMOOTH_KINDS[1]):
+        return px, py, pz
+    lx, ly, lz = terminator(g.objects[k], g.pool, prim, qx, qy, qz)
+    x = g.ints[k, XFORM]
+    if x >= 0:
+        lx, ly, lz = linear(g.transforms[x], WORLD, lx, ly, lz)
+    return px + lx, py + ly, pz + lz
 
 
 @per_ray(inline=True)
@@ -109,12 +129,12 @@ def transmittance(g, s, sx, sy, sz, dx, dy, dz, stack):
 
 
 @per_ray(inline=True)
-def local(g, s, m, Tr, Tg, Tb, px, py, pz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, counts, stack):
+def local(g, s, m, Tr, Tg, Tb, px, py, pz, bx, by, bz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, counts, stack):
     """The local term for one hit: emission and ambient, then each light point that sees it:
-    N.L > 0 and a shadow feeler from the point stepped off the surface reaching it."""
+    N.L > 0 and a shadow feeler from b (feeler_base) stepped off the surface reaching it."""
     cr, cg, cb = ambient(s, m, s.ambient, Tr, Tg, Tb)
     NV = dot(nx, ny, nz, Vx, Vy, Vz)
-    sx, sy, sz = px + s.offset * gx, py + s.offset * gy, pz + s.offset * gz    # the lit side
+    sx, sy, sz = bx + s.offset * gx, by + s.offset * gy, bz + s.offset * gz    # the lit side
     for li in range(len(s.lights)):
         light, samples = s.lights[li], s.samples[li]
         for cell in range(samples):
@@ -152,7 +172,9 @@ def shade_local(g, s, ray, f, counts, stack):
     m = material_of(g, k, prim)
     Dx, Dy, Dz = unit(dx, dy, dz)
     Tr, Tg, Tb = texture_at(g, s, m, k, prim, qx, qy, qz)
-    cr, cg, cb = local(g, s, m, Tr, Tg, Tb, px, py, pz, nx, ny, nz, gx, gy, gz, -Dx, -Dy, -Dz, counts, stack)
+    bx, by, bz = feeler_base(g, s, k, prim, px, py, pz, qx, qy, qz)
+    cr, cg, cb = local(g, s, m, Tr, Tg, Tb, px, py, pz, bx, by, bz, nx, ny, nz, gx, gy, gz, -Dx, -Dy, -Dz, counts,
+                       stack)
     f[COLOR_SUM], f[COLOR_SUM + 1], f[COLOR_SUM + 2] = cr, cg, cb
     f[P], f[P + 1], f[P + 2], f[N], f[N + 1], f[N + 2] = px, py, pz, nx, ny, nz
     f[NG], f[NG + 1], f[NG + 2], f[D], f[D + 1], f[D + 2] = gx, gy, gz, Dx, Dy, Dz

@@ -40,16 +40,19 @@ from collections import namedtuple
 import numpy as np
 
 from rtcli.core.bvh import BVH, padded
+from rtcli.core.objects import singles, sphere_blocks
 from rtcli.core.scene import object_tree
 from rtcli.core.transform import PACKED
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import POOL_WIDTH
 from rtcli.shapes.csg import CSG, OPS
+from rtcli.shapes.sphere import Sphere
 
 SHAPE_WIDTH = 20                                   # columns of an object row: the widest shape's row
 KIND, XFORM, CASTS, MATERIAL = range(4)            # columns of ints
 KINDS = {cls: k for k, cls in enumerate(SHAPES.values())}
 CSG_KIND = len(KINDS)
+SMOOTH_KINDS = (KINDS[SHAPES["triangle"]], KINDS[SHAPES["mesh"]])     # shapes with a shadow-terminator shift
 # A csg's row: where its program starts and how long it is, its leaf count, how many spans its
 # leaves can give (SPANS: the capacity of its span lists), its largest number of children, its
 # scratch (in the traversal stack), and its object-space box (BOUNDED 0: none).
@@ -70,12 +73,12 @@ ROW, DEPTH, PATH = 1, 2, 4                         # columns of leaves (KIND and
 Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool program leaves")
 Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear fresnel filters texture "
                             "texels lights samples ambient background offset max_depth blinn medium_ior "
-                            "reflect_tir any_filter")
+                            "reflect_tir any_filter terminator")
 
 
 def unsupported(scene) -> str | None:
     """Why the compiled engine cannot render `scene`, or None when it can."""
-    for o in scene.objects:
+    for _, o in singles(scene.objects):                 # a block's spheres are supported
         if type(o.shape) not in KINDS and not isinstance(o.shape, CSG):
             return f"{o.kind or type(o.shape).__name__} objects"
     return None
@@ -163,14 +166,15 @@ class _Trees:
                 np.concatenate(self.perm).astype(np.int64))
 
 
-def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int]:
+def geometry(scene, tree: bool, bvh: tuple | None = None, levels=None) -> tuple[Geometry, int]:
     """The scene's geometry, and the traversal stack it needs (the scene's tree, then a mesh's).
-    Without `tree` every object is listed, in file order; `bvh`: object_tree's, if made already."""
+    Without `tree` every object is listed, in file order; `bvh`: object_tree's, if made already;
+    `levels`: the compiled tree build (core/bvh_build.py; the same tree as numpy's, sooner)."""
     n = len(scene.objects)
     objects, ints = np.zeros((n, SHAPE_WIDTH)), np.zeros((n, 4), dtype=np.int64)
     bounded = scene.boxes.bounded
     listed = np.flatnonzero(~bounded | (not tree))
-    members, scene_bvh = (bvh or object_tree(scene)) if tree else (np.zeros(0, np.int64), BVH(np.zeros((0, 3)),
+    members, scene_bvh = (bvh or object_tree(scene, levels)) if tree else (np.zeros(0, np.int64), BVH(np.zeros((0, 3)),
                                                                                              np.zeros((0, 3))))
     trees, mesh_depth, transforms, csgs, csg_scratch = _Trees(), 0, [], _CSGs(n), 0
     trees.add(scene_bvh, members)                    # root 0
@@ -183,8 +187,9 @@ def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int
         if shape.FIRST_COLUMN is not None:
             row[shape.FIRST_COLUMN] = n_pool
         if shape.ROOT_COLUMN is not None:
-            row[shape.ROOT_COLUMN] = trees.add(shape.bvh, np.arange(len(shape.pool)) + n_pool)
-            mesh_depth = max(mesh_depth, shape.bvh.depth)
+            tree = shape.tree(levels)                       # a mesh's, by the compiled build when given
+            row[shape.ROOT_COLUMN] = trees.add(tree, np.arange(len(shape.pool)) + n_pool)
+            mesh_depth = max(mesh_depth, tree.depth)
         if len(row) > SHAPE_WIDTH:
             raise ValueError(f"a {type(shape).__name__} row is wider than {SHAPE_WIDTH} columns")
         if len(shape.pool):
@@ -192,7 +197,12 @@ def geometry(scene, tree: bool, bvh: tuple | None = None) -> tuple[Geometry, int
             n_pool += len(shape.pool)
         return row
 
-    for k, o in enumerate(scene.objects):
+    for start, block in sphere_blocks(scene.objects):          # spheres kept as arrays (core/objects.py)
+        end = start + len(block)
+        objects[start:end, :block.rows.shape[1]] = block.rows
+        ints[start:end] = np.stack([np.full(len(block), KINDS[Sphere]), np.full(len(block), -1),
+                                    scene.materials.shadow[block.material], block.material], axis=1)
+    for k, o in singles(scene.objects):
         shape = o.shape
         if isinstance(shape, CSG):
             objects[k], kind = csgs.add(shape, transforms), CSG_KIND
@@ -232,7 +242,7 @@ def looks(scene) -> Looks:
                  samples, np.asarray(scene.ambient, float), np.asarray(scene.background, float),
                  float(scene.offset), int(scene.settings.max_depth), scene.settings.specular == "blinn",
                  float(scene.settings.medium_ior), scene.settings.total_internal_reflection == "reflect",
-                 bool(table.filters.any()))
+                 bool(table.filters.any()), scene.settings.shadow_terminator == "offset")
 
 
 def frames(max_depth: int) -> np.ndarray:

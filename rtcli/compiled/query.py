@@ -9,9 +9,9 @@ first listed object, as in the numpy engine; between two objects of a BVH it may
 to the other one than the numpy engine's level-by-level walk picks.
 
 Which shape's kernel to call is decided by the object's KIND, through a chain of
-tests built from the registry when this module is imported (`chain`): adding a shape
-to rtcli/shapes/ adds it here too. This module compiles with numba: import it only
-when numba is installed.
+tests built from the registry (rtcli/compiled/dispatch.py), ending in the CSG's link
+(`csg_link`, its NEXT bound as the chain is made). This module compiles with numba:
+import it only when numba is installed.
 
 A CSG is a program (rtcli/compiled/pack.py): `csg_hit` runs it for one ray with a
 stack of span lists in the traversal stack, each leaf's spans from its shape's `spans`
@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rtcli.compiled.dispatch import NEXT, WALK_TRIANGLES, chain, no_hit, no_normals, no_uv, spans_chain
 from rtcli.compiled.pack import (
     BOUNDED,
     CASTS,
@@ -46,111 +47,8 @@ from rtcli.compiled.pack import (
 )
 from rtcli.core.bvh import ANY_CASTER, CHILD, COUNT, NEAREST, reciprocal, slab, walk, walk_rays
 from rtcli.core.transform import OBJECT, affine, normal_to_world, ray_to_object
-from rtcli.shapes import SHAPES
-from rtcli.shapes.csg import combine, nearest
-from rtcli.shapes.triangle import triangle_leaf
 from rtcli.kernels.variants import INF, compiled, per_ray, to_int
-
-
-# --- the dispatch on the shape's kind: one link per registered shape ---
-@per_ray(inline=True)
-def hit_link(kind, row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
-    """HIT of the shape of kind KIND, else the next link's answer."""
-    if kind == KIND_HERE:                                                           # noqa: F821
-        return HIT(row, g.pool, ox, oy, oz, dx, dy, dz, t_min, t_max)                # noqa: F821
-    return NEXT(kind, row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)  # noqa: F821
-
-
-@per_ray(inline=True)
-def walk_link(kind, row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
-    """A shape hit through its own BVH over pool triangles (a mesh): prim is the face's index."""
-    if kind == KIND_HERE:                                                           # noqa: F821
-        t, face, _ = WALK_TRIANGLES(g, to_int(row[ROOT_AT]), ox, oy, oz, dx, dy, dz, t_min, t_max,  # noqa: F821
-                                    shadow, stack, bottom)
-        return t, face - to_int(row[FIRST_AT])                                      # noqa: F821
-    return NEXT(kind, row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)  # noqa: F821
-
-
-@per_ray(inline=True)
-def point_link(kind, row, pool, prim, x, y, z):
-    """KERNEL (normals or uv) of the shape of kind KIND at a point, else the next link's."""
-    if kind == KIND_HERE:                                                           # noqa: F821
-        return KERNEL(row, pool, prim, x, y, z)                                      # noqa: F821
-    return NEXT(kind, row, pool, prim, x, y, z)                                      # noqa: F821
-
-
-@per_ray(inline=True)
-def no_hit(kind, row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
-    return INF, 0
-
-
-@per_ray(inline=True)
-def no_normals(kind, row, pool, prim, x, y, z):
-    return 0.0, 0.0, 1.0, 0.0, 0.0, 1.0
-
-
-@per_ray(inline=True)
-def no_uv(kind, row, pool, prim, x, y, z):
-    return 0.0, 0.0
-
-
-def chain(name: str, end, **bind):
-    """The dispatcher calling each registered shape's kernel `name` by kind (then `end`, with `bind`)."""
-    link = compiled(end, **bind)
-    for kind, cls in reversed(list(enumerate(SHAPES.values()))):
-        kernel = getattr(cls.kernels, name)
-        if name == "hit" and kernel is None:
-            link = compiled(walk_link, KIND_HERE=kind, NEXT=link, ROOT_AT=cls.ROOT_COLUMN,
-                                FIRST_AT=cls.FIRST_COLUMN)
-        elif name == "hit":
-            link = compiled(hit_link, KIND_HERE=kind, HIT=kernel, NEXT=link)
-        else:
-            link = compiled(point_link, KIND_HERE=kind, KERNEL=kernel, NEXT=link)
-    return link
-
-
-@per_ray(inline=True)
-def spans_link(kind, row, pool, ox, oy, oz, dx, dy, dz, bt, bid, at, ident, stride):
-    """SPANS of the solid of kind KIND_HERE stored in a span list from bt[at], bid[at] (each
-    boundary's id: ident + stride x its surface); how many boundaries. Else the next link's answer."""
-    if kind == KIND_HERE:                                                           # noqa: F821
-        STORE(SPANS(row, pool, ox, oy, oz, dx, dy, dz), bt, bid, at, ident, stride)  # noqa: F821
-        return BOUNDARIES                                                           # noqa: F821
-    return NEXT(kind, row, pool, ox, oy, oz, dx, dy, dz, bt, bid, at, ident, stride)  # noqa: F821
-
-
-@per_ray(inline=True)
-def no_spans(kind, row, pool, ox, oy, oz, dx, dy, dz, bt, bid, at, ident, stride):
-    return 0
-
-
-@per_ray(inline=True)
-def store_span(parts, bt, bid, at, ident, stride):
-    """Span J of a spans kernel's answer (t_in, prim_in, t_out, prim_out, t_in, ...) as the list's
-    boundaries 2 J and 2 J + 1, then the next spans (STORE_NEXT)."""
-    bt[at + T_AT], bid[at + T_AT] = parts[T_IN], ident + stride * parts[P_IN]                # noqa: F821
-    bt[at + T_AT + 1], bid[at + T_AT + 1] = parts[T_OUT], ident + stride * parts[P_OUT]      # noqa: F821
-    STORE_NEXT(parts, bt, bid, at, ident, stride)                                           # noqa: F821
-
-
-@per_ray(inline=True)
-def stored(parts, bt, bid, at, ident, stride):
-    return
-
-
-def spans_chain():
-    """SPANS_ANY: the `spans` kernel of each registered solid, by kind, into a span list."""
-    link = compiled(no_spans)
-    for kind, cls in reversed(list(enumerate(SHAPES.values()))):
-        if cls.kernels.spans is None:
-            continue
-        store = compiled(stored)
-        for j in reversed(range(cls.SPANS)):                 # one store per span: tuple indices are constants
-            store = compiled(store_span, T_AT=2 * j, T_IN=4 * j, P_IN=4 * j + 1, T_OUT=4 * j + 2, P_OUT=4 * j + 3,
-                             STORE_NEXT=store)
-        link = compiled(spans_link, KIND_HERE=kind, SPANS=cls.kernels.spans, STORE=store, BOUNDARIES=2 * cls.SPANS,
-                        NEXT=link)
-    return link
+from rtcli.shapes.csg import combine, nearest
 
 
 # --- CSG: its program run for one ray, and its surfaces ---
@@ -205,7 +103,7 @@ def csg_link(kind, row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, 
     """The end of HIT_ANY: a csg's hit, else the next link's answer."""
     if kind == CSG_KIND:
         return csg_hit(g, row, ox, oy, oz, dx, dy, dz, t_min, t_max, stack, bottom)
-    return NEXT(kind, row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)  # noqa: F821
+    return NEXT(kind, row, g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)
 
 
 @per_ray(inline=True)
@@ -253,7 +151,6 @@ def material_of(g, k, prim):
     return g.ints[k, MATERIAL]
 
 
-WALK_TRIANGLES = compiled(walk, LEAF=triangle_leaf)
 SPANS_ANY = spans_chain()
 HIT_ANY = chain("hit", csg_link, NEXT=compiled(no_hit))
 NORMALS_ANY, UV_ANY = chain("normals", no_normals), chain("uv", no_uv)

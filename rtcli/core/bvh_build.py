@@ -8,11 +8,9 @@ by count. A split keeps the primitives' order on each side. Nodes are numbered l
 by level, a node's two children side by side, and the leaves' primitives are laid
 out level by level in `perm` (the layout of core/bvh.py).
 
-Two builds make the same tree, number for number (tests/test_bvh.py):
-- `numpy_build`: all nodes of a level at once, no per-primitive Python loop. Boxes
-  are (3, m) rows, so that each gather, reduction and scatter runs over contiguous
-  arrays, and a level's bins are [bin, ..., node] arrays whose running minima run over
-  contiguous rows.
+Two builds make the same tree, number for number (tests/core/test_bvh.py):
+- `numpy_build` (rtcli/core/bvh_build_numpy.py): all nodes of a level at once, no
+  per-primitive Python loop.
 - `levels`, per node and per primitive (python and compiled variants, rtcli/kernels/variants.py):
   the compiled one builds 100,000 triangles' tree in a few hundredths of a second.
 `build` runs `levels` when it is given a runner of it (the compiled variant, from its machine
@@ -24,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rtcli.core.bvh_build_numpy import numpy_build
 from rtcli.kernels.variants import INF, per_ray
 
 
@@ -85,16 +84,8 @@ def levels(lo, hi, leaf_size, bins, n_lo, n_hi, child, start, count, perm, work,
     are kept in node order with their boxes (the next level's in a second pair of
     arrays, leaves left out), and a split sums up its children's boxes and centroid
     bounds as it writes them, so that each level reads its primitives twice, in order."""
-    m = lo.shape[0]
-    for j in range(3):
-        bounds[0, 0, j], bounds[0, 1, j] = lo[0, j], hi[0, j]
-        bounds[0, 2, j] = bounds[0, 3, j] = (lo[0, j] + hi[0, j]) / 2
-    for q in range(1, m):
-        for j in range(3):
-            bounds[0, 0, j], bounds[0, 1, j] = min(bounds[0, 0, j], lo[q, j]), max(bounds[0, 1, j], hi[q, j])
-            cj = (lo[q, j] + hi[q, j]) / 2
-            bounds[0, 2, j], bounds[0, 3, j] = min(bounds[0, 2, j], cj), max(bounds[0, 3, j], cj)
-    sizes[0], k, first, placed, depth = m, 1, 0, 0, 0
+    root_bounds(lo, hi, bounds)
+    sizes[0], k, first, placed, depth = lo.shape[0], 1, 0, 0, 0
     while k > 0:
         depth += 1
         offset, inner, out = 0, 0, 0                    # out: where the next level's list has got to
@@ -108,86 +99,14 @@ def levels(lo, hi, leaf_size, bins, n_lo, n_hi, child, start, count, perm, work,
                 for q in range(offset, end):
                     perm[placed] = work[q]
                     placed += 1
-                offset = end
-                continue
-            child[node], start[node], count[node] = first + k + 2 * inner, 0, 0
-            # the bins: each primitive's bin per axis, per bin its count and box
-            for j in range(3):
-                c_lo, c_hi = bounds[i, 2, j], bounds[i, 3, j]
-                scale[j] = bins / (c_hi - c_lo) if c_hi > c_lo else 0.0
-            for axis in range(3):
-                for bin in range(bins):
-                    n[axis, bin] = 0
-                    for j in range(3):
-                        b_lo[axis, bin, j], b_hi[axis, bin, j] = INF, -INF
-            for q in range(offset, end):
-                lx, ly, lz, hx, hy, hz = p_lo[q, 0], p_lo[q, 1], p_lo[q, 2], p_hi[q, 0], p_hi[q, 1], p_hi[q, 2]
-                for axis in range(3):
-                    bin = min(int(((p_lo[q, axis] + p_hi[q, axis]) / 2 - bounds[i, 2, axis]) * scale[axis]),
-                              bins - 1)
-                    n[axis, bin] += 1
-                    b_lo[axis, bin, 0], b_hi[axis, bin, 0] = min(b_lo[axis, bin, 0], lx), max(b_hi[axis, bin, 0], hx)
-                    b_lo[axis, bin, 1], b_hi[axis, bin, 1] = min(b_lo[axis, bin, 1], ly), max(b_hi[axis, bin, 1], hy)
-                    b_lo[axis, bin, 2], b_hi[axis, bin, 2] = min(b_lo[axis, bin, 2], lz), max(b_hi[axis, bin, 2], hz)
-            # the cuts: after bin 0 .. bins - 2, on each axis; the first of least cost wins
-            best, best_axis, best_cut = INF, 0, -1
-            for axis in range(3):
-                rn, lx, ly, lz, hx, hy, hz = 0, INF, INF, INF, -INF, -INF, -INF
-                for bin in range(bins - 1, 0, -1):      # right of a cut: bins bin .. bins - 1
-                    rn += n[axis, bin]
-                    lx, ly, lz = min(lx, b_lo[axis, bin, 0]), min(ly, b_lo[axis, bin, 1]), min(lz, b_lo[axis, bin, 2])
-                    hx, hy, hz = max(hx, b_hi[axis, bin, 0]), max(hy, b_hi[axis, bin, 1]), max(hz, b_hi[axis, bin, 2])
-                    ex, ey, ez = hx - lx, hy - ly, hz - lz
-                    right_n[bin], right_area[bin] = rn, ex * ey + ey * ez + ez * ex
-                ln, lx, ly, lz, hx, hy, hz = 0, INF, INF, INF, -INF, -INF, -INF
-                for cut in range(bins - 1):             # left of it: bins 0 .. cut
-                    if n[axis, cut] == 0:
-                        continue                        # the cost of the cut before, which comes first
-                    ln += n[axis, cut]
-                    lx, ly, lz = min(lx, b_lo[axis, cut, 0]), min(ly, b_lo[axis, cut, 1]), min(lz, b_lo[axis, cut, 2])
-                    hx, hy, hz = max(hx, b_hi[axis, cut, 0]), max(hy, b_hi[axis, cut, 1]), max(hz, b_hi[axis, cut, 2])
-                    if ln > 0 and right_n[cut + 1] > 0:
-                        ex, ey, ez = hx - lx, hy - ly, hz - lz
-                        cost = ln * (ex * ey + ey * ez + ez * ex) + right_n[cut + 1] * right_area[cut + 1]
-                        if cost < best:
-                            best, best_axis, best_cut = cost, axis, cut
-            # the split into the next level's arrays, in order on each side (halved by count
-            # when no cut has a finite cost), with the children's bounds
-            n_left = size // 2
-            if best < INF:
-                n_left = 0
-                for bin in range(best_cut + 1):
-                    n_left += n[best_axis, bin]
-            left, right = 2 * inner, 2 * inner + 1
-            next_sizes[left], next_sizes[right] = n_left, size - n_left
-            for side in (left, right):
-                for j in range(3):
-                    next_bounds[side, 0, j], next_bounds[side, 2, j] = INF, INF
-                    next_bounds[side, 1, j], next_bounds[side, 3, j] = -INF, -INF
-            to_left, to_right = out, out + n_left
-            for q in range(offset, end):
-                if best < INF:
-                    c = (p_lo[q, best_axis] + p_hi[q, best_axis]) / 2
-                    goes_left = min(int((c - bounds[i, 2, best_axis]) * scale[best_axis]), bins - 1) <= best_cut
-                else:
-                    goes_left = q - offset < n_left
-                if goes_left:
-                    to, side = to_left, left
-                    to_left += 1
-                else:
-                    to, side = to_right, right
-                    to_right += 1
-                work2[to] = work[q]
-                for j in range(3):
-                    l, h = p_lo[q, j], p_hi[q, j]
-                    p_lo2[to, j], p_hi2[to, j] = l, h
-                    next_bounds[side, 0, j], next_bounds[side, 1, j] = min(next_bounds[side, 0, j], l), \
-                        max(next_bounds[side, 1, j], h)
-                    cj = (l + h) / 2
-                    next_bounds[side, 2, j], next_bounds[side, 3, j] = min(next_bounds[side, 2, j], cj), \
-                        max(next_bounds[side, 3, j], cj)
-            inner += 1
-            out += size
+            else:
+                child[node], start[node], count[node] = first + k + 2 * inner, 0, 0
+                fill_bins(bounds, i, offset, end, bins, p_lo, p_hi, n, b_lo, b_hi, scale)
+                best, axis, cut = cheapest_cut(bins, n, b_lo, b_hi, right_n, right_area)
+                split(bounds, i, offset, end, best, axis, cut, bins, scale, n, 2 * inner, out, work, p_lo, p_hi,
+                      work2, p_lo2, p_hi2, next_sizes, next_bounds)
+                inner += 1
+                out += size
             offset = end
         work, work2, p_lo, p_lo2, p_hi, p_hi2 = work2, work, p_lo2, p_lo, p_hi2, p_hi
         sizes, next_sizes, bounds, next_bounds = next_sizes, sizes, next_bounds, bounds
@@ -196,119 +115,106 @@ def levels(lo, hi, leaf_size, bins, n_lo, n_hi, child, start, count, perm, work,
     return first, depth
 
 
-def numpy_build(lo, hi, leaf_size, bins):
-    """The tree with numpy, all nodes of a level at once (see the module docstring)."""
-    lo_t, hi_t = np.ascontiguousarray(lo.T, dtype=np.float64), np.ascontiguousarray(hi.T, dtype=np.float64)
-    p_lo, p_hi, c = lo_t, hi_t, (lo_t + hi_t) / 2         # boxes and centroids of `work`, as (3, a) rows
-    work = np.arange(len(lo))                 # primitives of this level's nodes, node by node
-    count = np.array([len(lo)])               # primitives per node of this level
-    levels, perm, placed, first = [], [], 0, 0
-    while len(count):
-        start = np.cumsum(count) - count
-        leaf = count <= leaf_size
-        inner = ~leaf
-        n_inner = np.count_nonzero(inner)
-        leaf_start = np.zeros(len(count), dtype=np.int64)
-        child = np.full(len(count), -1, dtype=np.int64)
-        child[inner] = first + len(count) + 2 * np.arange(n_inner)
-        levels.append((np.minimum.reduceat(p_lo, start, axis=1), np.maximum.reduceat(p_hi, start, axis=1),
-                       child, leaf_start, np.where(leaf, count, 0)))
-        first += len(count)
-        if n_inner < len(count):
-            in_leaf = np.repeat(leaf, count)
-            leaf_start[leaf] = placed + np.cumsum(count[leaf]) - count[leaf]
-            perm.append(work[in_leaf])
-            placed += len(perm[-1])
-            if n_inner == 0:
-                break
-            keep = ~in_leaf
-            work, count, p_lo, p_hi, c = work[keep], count[inner], p_lo[:, keep], p_hi[:, keep], c[:, keep]
-        dest, count = _split(count, p_lo, p_hi, c, bins)
-        work, p_lo, p_hi, c = (_scatter(dest, x) for x in (work, p_lo, p_hi, c))
-    n_lo, n_hi, child, start, count = (np.concatenate(x, axis=-1) for x in zip(*levels))
-    return n_lo.T, n_hi.T, child, start, count, np.concatenate(perm), len(levels)
-
-
-def _scatter(dest, x):
-    """x with its last axis reordered: item i goes to dest[i]."""
-    out = np.empty_like(x)
-    out[..., dest] = x
-    return out
-
-
-def _split(count, p_lo, p_hi, c, bins):
-    """Each node's best SAH cut: where each primitive goes (a stable partition, node by node)
-    and the children's counts. p_lo, p_hi, c: (3, a) boxes and centroids, node by node."""
-    k, a = len(count), c.shape[1]
-    seg = np.repeat(np.arange(k), count)
-    start = np.cumsum(count) - count
-    c_lo, c_hi = np.minimum.reduceat(c, start, axis=1), np.maximum.reduceat(c, start, axis=1)
-    with np.errstate(divide="ignore"):
-        scale = np.where(c_hi > c_lo, bins / (c_hi - c_lo), 0.0)
-    b = np.minimum(((c - np.repeat(c_lo, count, axis=1)) * np.repeat(scale, count, axis=1)).astype(np.int64),
-                   bins - 1)                                   # (3, a) bin per axis
-    axis, cut = _sah_cuts(b, seg, p_lo, p_hi, k, bins)
-    here = np.arange(a)
-    rank = here - np.repeat(start, count)
-    cut_of = np.repeat(cut, count)
-    left = np.where(cut_of >= 0, b.ravel()[np.repeat(axis * a, count) + here] <= cut_of,
-                    rank < np.repeat(count // 2, count))
-    lefts = np.cumsum(left)
-    before = np.concatenate(([0], lefts))[start]              # lefts in the nodes before
-    n_left = lefts[start + count - 1] - before
-    left_rank = lefts - left - np.repeat(before, count)       # lefts before this one in its node
-    dest = np.repeat(start, count) + np.where(left, left_rank, np.repeat(n_left, count) + rank - left_rank)
-    return dest, np.stack([n_left, count - n_left], axis=1).ravel()
-
-
-def _sah_cuts(b, seg, p_lo, p_hi, k, bins):
-    """Per node, the axis and last left bin of least SAH cost; cut -1 when no bin boundary splits.
-
-    Per axis, each primitive's (bin, node) slot gets its count and the min/max of its box;
-    running sums and minima/maxima over the bins, from either end, give both sides of each cut.
-    """
-    slots = b * (3 * k) + (np.arange(3)[:, None] * k + seg)                  # [bin, axis * k + node]
-    n = np.bincount(slots.ravel(), minlength=bins * 3 * k).reshape(bins, 3 * k)
-    b_lo = np.full((bins, 3, 3 * k), np.inf)                                  # [bin, coordinate, axis * k + node]
-    b_hi = np.full((bins, 3, 3 * k), -np.inf)
-    flat_lo, flat_hi = b_lo.reshape(-1), b_hi.reshape(-1)
-    for axis in range(3):
-        slot = b[axis] * (9 * k) + (axis * k + seg)
+@per_ray(inline=True)
+def root_bounds(lo, hi, bounds):
+    """The root's box and centroid bounds into bounds[0]: lo, hi, centroids' lo, centroids' hi."""
+    for j in range(3):
+        bounds[0, 0, j], bounds[0, 1, j] = lo[0, j], hi[0, j]
+        bounds[0, 2, j] = bounds[0, 3, j] = (lo[0, j] + hi[0, j]) / 2
+    for q in range(1, lo.shape[0]):
         for j in range(3):
-            np.minimum.at(flat_lo, slot + j * 3 * k, p_lo[j])
-            np.maximum.at(flat_hi, slot + j * 3 * k, p_hi[j])
-    n_l, n_r = _running(np.add, n), _running(np.add, n, backward=True)
-    a_l = _half_area(_running(np.minimum, b_lo), _running(np.maximum, b_hi))
-    a_r = _half_area(_running(np.minimum, b_lo, backward=True), _running(np.maximum, b_hi, backward=True))
-    n_l, a_l, n_r, a_r = n_l[:-1], a_l[:-1], n_r[1:], a_r[1:]              # cut after bin 0 .. bins - 2
-    with np.errstate(invalid="ignore"):
-        cost = np.where((n_l > 0) & (n_r > 0), n_l * a_l + n_r * a_r, np.inf)
-    cost = cost.reshape(bins - 1, 3, k).transpose(1, 0, 2).reshape(3 * (bins - 1), k)
-    best = np.argmin(cost, axis=0)                            # axis-major, then bin: the first least cost
-    ok = np.isfinite(cost[best, np.arange(k)])
-    return best // (bins - 1), np.where(ok, best % (bins - 1), -1)
+            bounds[0, 0, j], bounds[0, 1, j] = min(bounds[0, 0, j], lo[q, j]), max(bounds[0, 1, j], hi[q, j])
+            cj = (lo[q, j] + hi[q, j]) / 2
+            bounds[0, 2, j], bounds[0, 3, j] = min(bounds[0, 2, j], cj), max(bounds[0, 3, j], cj)
 
 
-def _running(op, x, backward=False):
-    """op accumulated over the first axis (the bins), from the first bin or from the last.
+@per_ray(inline=True)
+def fill_bins(bounds, i, offset, end, bins, p_lo, p_hi, n, b_lo, b_hi, scale):
+    """The bins of node i (its primitives offset .. end - 1): each primitive's bin per axis by its
+    centroid, per bin its count (n) and box (b_lo, b_hi); scale: bins per unit length, per axis."""
+    for j in range(3):
+        c_lo, c_hi = bounds[i, 2, j], bounds[i, 3, j]
+        scale[j] = bins / (c_hi - c_lo) if c_hi > c_lo else 0.0
+    for axis in range(3):
+        for bin in range(bins):
+            n[axis, bin] = 0
+            for j in range(3):
+                b_lo[axis, bin, j], b_hi[axis, bin, j] = INF, -INF
+    for q in range(offset, end):
+        lx, ly, lz, hx, hy, hz = p_lo[q, 0], p_lo[q, 1], p_lo[q, 2], p_hi[q, 0], p_hi[q, 1], p_hi[q, 2]
+        for axis in range(3):
+            bin = min(int(((p_lo[q, axis] + p_hi[q, axis]) / 2 - bounds[i, 2, axis]) * scale[axis]), bins - 1)
+            n[axis, bin] += 1
+            b_lo[axis, bin, 0], b_hi[axis, bin, 0] = min(b_lo[axis, bin, 0], lx), max(b_hi[axis, bin, 0], hx)
+            b_lo[axis, bin, 1], b_hi[axis, bin, 1] = min(b_lo[axis, bin, 1], ly), max(b_hi[axis, bin, 1], hy)
+            b_lo[axis, bin, 2], b_hi[axis, bin, 2] = min(b_lo[axis, bin, 2], lz), max(b_hi[axis, bin, 2], hz)
 
-    A loop over the few bins, each step one operation on a contiguous row: numpy's
-    accumulate along an axis other than the last is several times slower.
-    """
-    out = np.empty_like(x)
-    steps = range(len(x) - 1, -1, -1) if backward else range(len(x))
-    prev = None
-    for i in steps:
-        if prev is None:
-            out[i] = x[i]
+
+@per_ray(inline=True)
+def cheapest_cut(bins, n, b_lo, b_hi, right_n, right_area):
+    """(cost, axis, last bin on the left) of the cut of least SAH cost N_L A_L + N_R A_R, after bin
+    0 .. bins - 2 on each axis; the first of least cost wins; cost inf (cut -1) when none splits."""
+    best, best_axis, best_cut = INF, 0, -1
+    for axis in range(3):
+        rn, lx, ly, lz, hx, hy, hz = 0, INF, INF, INF, -INF, -INF, -INF
+        for bin in range(bins - 1, 0, -1):      # right of a cut: bins bin .. bins - 1
+            rn += n[axis, bin]
+            lx, ly, lz = min(lx, b_lo[axis, bin, 0]), min(ly, b_lo[axis, bin, 1]), min(lz, b_lo[axis, bin, 2])
+            hx, hy, hz = max(hx, b_hi[axis, bin, 0]), max(hy, b_hi[axis, bin, 1]), max(hz, b_hi[axis, bin, 2])
+            ex, ey, ez = hx - lx, hy - ly, hz - lz
+            right_n[bin], right_area[bin] = rn, ex * ey + ey * ez + ez * ex
+        ln, lx, ly, lz, hx, hy, hz = 0, INF, INF, INF, -INF, -INF, -INF
+        for cut in range(bins - 1):             # left of it: bins 0 .. cut
+            if n[axis, cut] == 0:
+                continue                        # the cost of the cut before, which comes first
+            ln += n[axis, cut]
+            lx, ly, lz = min(lx, b_lo[axis, cut, 0]), min(ly, b_lo[axis, cut, 1]), min(lz, b_lo[axis, cut, 2])
+            hx, hy, hz = max(hx, b_hi[axis, cut, 0]), max(hy, b_hi[axis, cut, 1]), max(hz, b_hi[axis, cut, 2])
+            if ln > 0 and right_n[cut + 1] > 0:
+                ex, ey, ez = hx - lx, hy - ly, hz - lz
+                cost = ln * (ex * ey + ey * ez + ez * ex) + right_n[cut + 1] * right_area[cut + 1]
+                if cost < best:
+                    best, best_axis, best_cut = cost, axis, cut
+    return best, best_axis, best_cut
+
+
+@per_ray(inline=True)
+def split(bounds, i, offset, end, best, best_axis, best_cut, bins, scale, n, left, out, work, p_lo, p_hi,
+          work2, p_lo2, p_hi2, next_sizes, next_bounds):
+    """Node i's primitives into the next level's arrays from `out`, in order on each side (halved
+    by count when no cut has a finite cost), as its children `left` and `left` + 1 with their sizes
+    and bounds."""
+    size = end - offset
+    n_left = size // 2
+    if best < INF:
+        n_left = 0
+        for bin in range(best_cut + 1):
+            n_left += n[best_axis, bin]
+    right = left + 1
+    next_sizes[left], next_sizes[right] = n_left, size - n_left
+    for side in (left, right):
+        for j in range(3):
+            next_bounds[side, 0, j], next_bounds[side, 2, j] = INF, INF
+            next_bounds[side, 1, j], next_bounds[side, 3, j] = -INF, -INF
+    to_left, to_right = out, out + n_left
+    for q in range(offset, end):
+        if best < INF:
+            c = (p_lo[q, best_axis] + p_hi[q, best_axis]) / 2
+            goes_left = min(int((c - bounds[i, 2, best_axis]) * scale[best_axis]), bins - 1) <= best_cut
         else:
-            op(out[prev], x[i], out=out[i])
-        prev = i
-    return out
-
-
-def _half_area(lo, hi):
-    """Half the surface area of boxes [..., coordinate, :]: ex ey + ey ez + ez ex (inf/NaN for empty boxes)."""
-    with np.errstate(invalid="ignore"):
-        e = hi - lo
-        return e[:, 0] * e[:, 1] + e[:, 1] * e[:, 2] + e[:, 2] * e[:, 0]
+            goes_left = q - offset < n_left
+        if goes_left:
+            to, side = to_left, left
+            to_left += 1
+        else:
+            to, side = to_right, right
+            to_right += 1
+        work2[to] = work[q]
+        for j in range(3):
+            l, h = p_lo[q, j], p_hi[q, j]
+            p_lo2[to, j], p_hi2[to, j] = l, h
+            next_bounds[side, 0, j], next_bounds[side, 1, j] = min(next_bounds[side, 0, j], l), \
+                max(next_bounds[side, 1, j], h)
+            cj = (l + h) / 2
+            next_bounds[side, 2, j], next_bounds[side, 3, j] = min(next_bounds[side, 2, j], cj), \
+                max(next_bounds[side, 3, j], cj)

@@ -24,6 +24,21 @@ def to_8bit(image: np.ndarray, gamma: bool = False) -> np.ndarray:
     return np.rint(c * 255).astype(np.uint8)
 
 
+def to_8bit_alpha(image: np.ndarray, gamma: bool = False) -> np.ndarray:
+    """(..., 4) straight colors and alpha: the colors as to_8bit, the alpha round(255 a) (never
+    sRGB-encoded)."""
+    return np.concatenate([to_8bit(image[..., :3], gamma), to_8bit(image[..., 3:])], axis=-1)
+
+
+def to_16bit(image: np.ndarray, gamma: bool = False) -> np.ndarray:
+    """(..., 3) or (..., 4) linear colors (and straight alpha) as 16-bit: clamped to [0, 1], the
+    colors optionally sRGB-encoded, round(65535 c)."""
+    c = np.clip(image, 0.0, 1.0)
+    if gamma:
+        c = np.concatenate([srgb_encode(c[..., :3]), c[..., 3:]], axis=-1)
+    return np.rint(c * 65535).astype(np.uint16)
+
+
 def palette(count: int) -> np.ndarray:
     """(count + 1, 3) uint8: black for id 0, then a fixed, distinct color per id.
 

@@ -1,7 +1,8 @@
 """The scene model: plain data built by rtcli/scenefile/, read by both engines. Picklable.
 
 A scene may hold a million objects, so per object it keeps little: a slotted
-SceneObject, its shape, and a row of the arrays below.
+SceneObject, its shape, and a row of the arrays below; or, for plain spheres, a row of
+a SphereBlock's arrays (core/objects.py).
 """
 
 from __future__ import annotations
@@ -14,29 +15,10 @@ import numpy as np
 
 from rtcli.core.bvh import BVH, PAD
 from rtcli.core.materials import MaterialTable
-from rtcli.core.transform import Transform, outer_bounds
+from rtcli.core.objects import SceneObject, singles, sphere_blocks
 from rtcli.core.vec import length3
 
 BVH_MIN_OBJECTS = 8        # from this many bounded objects on, a BVH over them pays (both engines)
-
-@dataclass(slots=True)
-class SceneObject:
-    id: int                          # 1, 2, 3 ... in file order (signature ids)
-    name: str
-    shape: object                    # a shape of rtcli.shapes, in object space
-    material: int                    # row of the scene's MaterialTable
-    world_from_object: Transform | None = None     # None: object space is world space
-    kind: str = ""                   # the YAML shape name, for legends
-    where: str = ""                  # where the scene file gives it, 'file:line:col: key.path', for messages
-    transform: np.ndarray | None = field(init=False, repr=False)   # packed for the kernels (core/transform.py)
-
-    def __post_init__(self):
-        self.transform = None if self.world_from_object is None else self.world_from_object.packed
-
-    def bounds(self) -> tuple[np.ndarray, np.ndarray] | None:
-        """World-space box, or None when unbounded."""
-        return outer_bounds(self.world_from_object, self.shape.bounds())
-
 
 class Boxes:
     """The objects' world-space boxes, padded like the BVH's nodes (core/bvh.py): boxes[k] is
@@ -45,10 +27,12 @@ class Boxes:
     def __init__(self, objects: list):
         n = len(objects)
         self.lo, self.hi = np.full((n, 3), np.nan), np.full((n, 3), np.nan)
-        for k, o in enumerate(objects):
+        for k, o in singles(objects):
             box = o.bounds()
             if box is not None:
                 self.lo[k], self.hi[k] = box
+        for start, block in sphere_blocks(objects):
+            self.lo[start:start + len(block)], self.hi[start:start + len(block)] = block.bounds()
         self.bounded = ~np.isnan(self.lo[:, 0])
         pad = PAD * np.maximum(np.abs(self.lo).max(axis=1), np.abs(self.hi).max(axis=1))
         pad = np.maximum(np.nan_to_num(pad), np.finfo(float).tiny)[:, None]
@@ -74,6 +58,8 @@ class Settings:
     epsilon: float = 1e-6            # self-intersection offset, relative to the scene's size
     medium_ior: float = 1.0          # index of refraction around every object (the camera's medium)
     total_internal_reflection: str = "drop"   # drop: the refracted weight is lost; reflect: to the mirror ray
+    alpha: bool = False              # the background transparent, in the images that have alpha
+    shadow_terminator: str = "none"  # none: feelers leave from the hit; offset: Hanika's shift on smooth faces
 
     @contextlib.contextmanager
     def overridden(self, samples: int | None, max_depth: int | None):

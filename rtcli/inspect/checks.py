@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rtcli.core.objects import object_materials
 from rtcli.core.scene import Scene
 from rtcli.errors import RtcliError, one_line, plural, shown
 from rtcli.scenefile.remarks import Remark, Remarks
@@ -206,7 +207,7 @@ def _out_of_reach(scene: Scene) -> list[Remark]:
     lo, hi = np.nan_to_num(boxes.lo), np.nan_to_num(boxes.hi)
     for light in scene.lights:
         reached |= _reaches(light, lo, hi)
-    rows = np.array([o.material for o in scene.objects], dtype=np.int64)
+    rows = object_materials(scene.objects)
     reached |= table.emission[rows].max(axis=1) > 0
     return [Remark(scene.objects[i].where, "no light reaches it: each light's attenuated intensity at its box "
                                            "is below 1/255, or a spot light's cone misses it")

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rtcli.errors import one_line
+from rtcli.errors import RtcliError, one_line
 from rtcli.inspect import explain_text
 
 Color = np.ndarray                 # (3,) float64
@@ -187,18 +187,26 @@ class Explanation:
 
     def to_dict(self, sample: int | None = None) -> dict:
         """Plain data (lists, numbers, strings) for JSON: every sample, or the one asked for."""
-        chosen = range(len(self.trees)) if sample is None else [sample]
+        chosen = range(len(self.trees)) if self._check(sample) is None else [sample]
         return {"pixel": [self.x, self.y], "image": [self.width, self.height],
                 "samples_per_pixel": self.samples ** 2, "value": self.value, "byte": self.byte,
                 "gamma": self.gamma,
                 "samples": [{"sample": k, "position": self.positions[k], "ray": _plain(self.trees[k])}
                             for k in chosen]}
 
+    def _check(self, sample):
+        """`sample` (None for every one); RtcliError unless it is one of the pixel's samples."""
+        n = len(self.trees)
+        if sample is not None and (isinstance(sample, bool) or not isinstance(sample, int) or not 0 <= sample < n):
+            raise RtcliError(f"sample must be None (every one) or an integer in 0..{n - 1}, got {one_line(repr(sample))[:60]}")
+        return sample
+
     def json(self, sample: int | None = None) -> str:
         return json.dumps(_plain(self.to_dict(sample)), indent=2)
 
     def text(self, sample: int | None = 0, style=None) -> str:
         """The tree as text; `style(text, role)` may color it (roles: ray, miss, term, sum, note)."""
+        self._check(sample)
         return explain_text.format_explanation(self, sample, style or (lambda text, role: text))
 
     def __str__(self) -> str:

@@ -41,7 +41,7 @@ class CacheLocation:
         """numba's cache folder set to this one while rtcli's functions are made (numba's cache of
         a function is placed when the function is made), and restored after: other numba users of
         the process keep theirs."""
-        from numba.core import config
+        from numba.core import config  # numba, optional (the fast extra): only when compiling
         saved = config.CACHE_DIR
         config.CACHE_DIR = self.root or ""
         try:

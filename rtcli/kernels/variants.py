@@ -53,8 +53,8 @@ import functools
 import hashlib
 import importlib.util
 import math
-import sys
 import os
+import sys
 import types
 
 import numpy as np
@@ -183,7 +183,7 @@ def _suffix(bind: dict) -> str:
 
 def _numba(f, how: Kernel, callee: bool = False):
     _start_numba()
-    from rtcli.kernels.dispatcher import Dispatcher  # start-up: numba, only when something compiles
+    from rtcli.kernels.dispatcher import Dispatcher  # numba, optional (the fast extra): only when compiling
     where = cache_location()
     options = dict(nopython=True, error_model="numpy", forceinline=how.inline)
     if not how.entry:

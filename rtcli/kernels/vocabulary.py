@@ -146,21 +146,21 @@ _EXACT_LIBM = ("sqrt", "copysign", "frexp", "ldexp")   # exact on any CPU; numba
 def numba_ops() -> dict:
     """The scalar ops as numba sees them: the same functions compiled; sqrt and copysign as LLVM's,
     frexp and ldexp from the bits."""
-    from numba import njit
+    from numba import njit  # numba, optional (the fast extra): only the compiled variant needs it
     from numba import types as nt
     from numba.extending import intrinsic
 
     @intrinsic
     def float_bits(typingctx, x):
         def codegen(context, builder, signature, args):
-            from llvmlite import ir
+            from llvmlite import ir  # numba's, when it generates code
             return builder.bitcast(args[0], ir.IntType(64))
         return nt.uint64(nt.float64), codegen
 
     @intrinsic
     def bits_float(typingctx, b):
         def codegen(context, builder, signature, args):
-            from llvmlite import ir
+            from llvmlite import ir  # numba's, when it generates code
             return builder.bitcast(args[0], ir.DoubleType())
         return nt.float64(nt.uint64), codegen
 

@@ -19,10 +19,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numpy as np
-
 from rtcli.errors import RtcliError, SceneError, error_line, shown
-from rtcli.rendering.writer import FORMATS
+from rtcli.rendering.outputs import check_outputs
+from rtcli.rendering.writer import FORMATS, Staged
 
 SCENE_SUFFIXES = (".yaml", ".yml")
 
@@ -69,18 +68,16 @@ def _stem(path: str) -> str:
 
 
 def run(items: list[Item], folder: str | None, load: Callable, render: Callable, *, ids: bool = False,
-        keep_going: Callable | None = None) -> list[tuple[Item, object, float]]:
+        keep_going: Callable | None = None, write: dict | None = None) -> list[tuple[Item, object, float]]:
     """Load and render each item, staging its image; all placed at the end, or none.
 
-    `load(path)` returns an api.Scene, `render(scene, label)` its 8-bit ImageArray (with `ids`,
-    its 16-bit id map). Returns (item, RenderStats, seconds from loading to staging) per scene.
+    `load(path)` returns an api.Scene, `render(scene, label)` its ImageArray (with `ids`, its
+    16-bit id map), staged by its stage() with the options `write` (bit_depth, half, gamma). Returns (item, RenderStats, seconds from loading to staging) per scene.
     `keep_going(item, error)`, when given, receives the error of each scene that fails to load
     or render (RtcliError, MemoryError), which is then left out while the others are placed; the
     folder made for them stays, even empty. An error about the outputs (one that is an input of
     a scene, or cannot be written) still stops the run with nothing placed.
     """
-    from rtcli.rendering.outputs import check_outputs
-    from rtcli.rendering.writer import Staged
     made = make_folder(folder)
     done, inputs, outputs = [], [], [(item.output, ids) for item in items]
     try:
@@ -95,7 +92,7 @@ def run(items: list[Item], folder: str | None, load: Callable, render: Callable,
                 image = _attempt(item, keep_going, render, scene, os.path.basename(item.scene))
                 if image is None:
                     continue
-                staged.add(item.output, np.asarray(image))
+                image.stage(staged, item.output, **(write or {}))
                 done.append((item, image.stats, time.perf_counter() - start))
             staged.commit()
     except BaseException:

@@ -12,21 +12,26 @@ them stops the run before it writes anything.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
+import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from PIL import Image, UnidentifiedImageError
 
 from rtcli.errors import RtcliError, shown
-from rtcli.rendering.movie import check_size, is_movie, movie_format, write_movie
+from rtcli.rendering.movie import check_rate, check_size, is_movie, movie_format, write_movie
+from rtcli.rendering.provenance import provenance
 from rtcli.rendering.tiles import render as render_tiles
 from rtcli.rendering.writer import write_png
 from rtcli.scenefile.animation import Animation
 from rtcli.stats import Stats
 
-PATTERN = re.compile(r"(?:[^%]|%%)*%0?[1-9]?\d*d(?:[^%]|%%)*", re.DOTALL)    # exactly one %d, %04d ...
+PATTERN = re.compile(r"(?:[^%]|%%)*%0?(?:[1-9]\d?)?d(?:[^%]|%%)*", re.DOTALL)  # one %d, %04d ... (width < 100)
 
 
 def _frames_of(animation: Animation, scene_file: str) -> str:
@@ -73,11 +78,13 @@ def sequence(animation: Animation, scene_file: str, output: str | None, frames: 
                          "for one image a frame, name them .png (frame_%04d.png)")
     wanted = [frame] if frame else _range(frames, animation, scene_file)
     movies = [m for m in (output if is_movie(output) else None, movie) if m]
+    for m in movies:
+        check_rate(m, len(wanted), animation.clock.fps)
     if output and not is_movie(output):
         if "%" in output:
             if not PATTERN.fullmatch(output):
-                raise RtcliError(f"-o {shown(output)}: a frame pattern has one %d (or %04d ...) for the frame "
-                                 "number, and %% for a percent sign")
+                raise RtcliError(f"-o {shown(output)}: a frame pattern has one %d (or %04d ..., a width below "
+                                 "100) for the frame number, and %% for a percent sign")
             return Sequence(wanted, {k: output % k for k in wanted}, movies)
         if len(wanted) > 1:
             raise RtcliError(f"-o {shown(output)}: {len(wanted)} frames need a name with the frame number "
@@ -112,14 +119,29 @@ def to_render(seq: Sequence, skip_existing: bool, job) -> list[int]:
 def has_image(path: str, width: int, height: int) -> bool:
     """Whether `path` is a regular file holding an image of width x height (only its header is read):
     what --skip-existing keeps."""
-    from PIL import Image, UnidentifiedImageError
     if not os.path.isfile(path):
         return False
     try:
-        with Image.open(path) as img:
+        with _frame_file(path, width, height) as img:
             return img.size == (width, height)
-    except (OSError, UnidentifiedImageError, ValueError):
+    except (OSError, UnidentifiedImageError, ValueError, Image.DecompressionBombError):
         return False
+
+
+@contextlib.contextmanager
+def _frame_file(path: str, width: int, height: int):
+    """An earlier frame opened by Pillow (its header read): one that says it holds more pixels
+    than width x height is a DecompressionBombError before anything is decoded, never
+    Pillow's warning."""
+    threshold = Image.MAX_IMAGE_PIXELS
+    Image.MAX_IMAGE_PIXELS = (width * height + 1) // 2          # Pillow refuses above twice this
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            with Image.open(path) as img:
+                yield img
+    finally:
+        Image.MAX_IMAGE_PIXELS = threshold
 
 
 def render_sequence(loaded, seq: Sequence, job, skip_existing: bool, frames: Callable) -> Stats:
@@ -134,17 +156,30 @@ def render_sequence(loaded, seq: Sequence, job, skip_existing: bool, frames: Cal
         if k != loaded.frame:
             loaded.animation.scene(k)                          # every frame checked before any is rendered
     movie = {k: _read_back(seq.paths[k], job) for k in seq.frames if k not in todo and seq.movies}
-    stats = Stats()
+    stats, start, total = Stats(), time.perf_counter(), 0.0
     for k, image, s in frames(todo) if todo else ():
+        seconds = time.perf_counter() - start
+        total += seconds
         if k in seq.paths:
-            write_png(seq.paths[k], image)
+            write_png(seq.paths[k], image, frame_meta(loaded, job, k, s.engine, seconds))
         if seq.movies:
             movie[k] = image
         stats.add(s)
         stats.engine = s.engine
+        start = time.perf_counter()
+    frame_range = f"{seq.frames[0]}-{seq.frames[-1]}" if seq.frames else "-"
     for path in seq.movies:
-        write_movie(path, [movie[k] for k in seq.frames], loaded.animation.clock.fps)
+        write_movie(path, [movie[k] for k in seq.frames], loaded.animation.clock.fps,
+                    frame_meta(loaded, job, frame_range, stats.engine, total))
     return stats
+
+
+def frame_meta(loaded, job, frame, engine: str, seconds: float) -> dict[str, str]:
+    """The provenance of frame `frame`'s image (rendering/provenance.py), or of a movie's ("FIRST-LAST");
+    `seconds` from the end of the frame before (or the start) to this one's, or of the frames rendered."""
+    s = loaded.scene.settings
+    return provenance(loaded.path, job.width, job.height, samples=s.samples, max_depth=s.max_depth, frame=frame,
+                      block_size=job.block_size, gamma=job.gamma, engine=engine or "none", seconds=seconds)
 
 
 def local_frames(loaded, todo: list[int], job, workers: int, changes: dict, progress=None):
@@ -157,14 +192,18 @@ def local_frames(loaded, todo: list[int], job, workers: int, changes: dict, prog
 
 
 def _read_back(path: str, job) -> np.ndarray:
-    """A frame written by an earlier run, for a movie."""
-    from PIL import Image, UnidentifiedImageError
+    """A frame written by an earlier run, for a movie: decoded only when its header says it is
+    of the job's size, so it takes no more memory than the frame rendered would."""
     try:
-        with Image.open(path) as img:
+        with _frame_file(path, job.width, job.height) as img:
+            if img.size != (job.width, job.height):
+                raise RtcliError(f"{shown(path)}: an earlier frame of {img.size[0]}x{img.size[1]}, not "
+                                 f"{job.width}x{job.height}: render it again (without --skip-existing)")
             pixels = np.asarray(img.convert("RGB"))
-    except (OSError, UnidentifiedImageError) as e:
-        raise RtcliError(f"{shown(path)}: cannot read this earlier frame for the movie: {e}") from None
-    if pixels.shape != (job.height, job.width, 3):
-        raise RtcliError(f"{shown(path)}: an earlier frame of {pixels.shape[1]}x{pixels.shape[0]}, not "
-                         f"{job.width}x{job.height}: render it again (without --skip-existing)")
+    except Image.DecompressionBombError:
+        raise RtcliError(f"{shown(path)}: an earlier frame larger than {job.width}x{job.height}: render it "
+                         "again (without --skip-existing)") from None
+    except (OSError, UnidentifiedImageError, ValueError) as e:
+        reason = " ".join(str(e).split()) or type(e).__name__
+        raise RtcliError(f"{shown(path)}: cannot read this earlier frame for the movie: {reason}") from None
     return pixels

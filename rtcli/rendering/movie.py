@@ -6,7 +6,9 @@ milliseconds). Delays are whole ticks that alternate so the movie keeps its fram
 rate (`delays`). Both loop forever. The
 movie is written to a temporary file beside its name and renamed into place, so an
 interrupted run leaves no half-written movie; its frames are held in memory until
-then (3 bytes a pixel a frame, checked by `check_size`).
+then (3 bytes a pixel a frame, checked by `check_size`). A frame lasts at most what its
+format can say (MAX_DELAY, checked by `check_rate` before any frame is rendered); a GIF
+merges identical frames in a row into one, whose delay is checked as the movie is written.
 """
 
 from __future__ import annotations
@@ -16,13 +18,17 @@ import os
 
 import numpy as np
 from PIL import Image
+from PIL.PngImagePlugin import PngInfo
 
 from rtcli.errors import RtcliError, quoted, shown
+from rtcli.rendering import provenance
 from rtcli.rendering.writer import write_atomic
 
 FORMATS = {".apng": "PNG", ".gif": "GIF"}
 TICK = {"PNG": 1, "GIF": 10}              # ms: the step of a frame's delay as written (Pillow's APNG: 1/1000 s)
 MAX_BYTES = 4 << 30                       # frames held in memory for one movie
+MAX_DELAY = {"PNG": 65535, "GIF": 655350}  # ms a frame may last: 65535 / 1000 s (Pillow's APNG), 65535 ticks
+KIND = {"PNG": "an animated PNG", "GIF": "a GIF"}
 
 
 def movie_format(path: str) -> str:
@@ -48,12 +54,46 @@ def check_size(frames: int, width: int, height: int) -> None:
                          "to files instead (-o frame_%04d.png)")
 
 
-def write_movie(path: str, frames: list[np.ndarray], fps: float) -> None:
-    """Write uint8 (H, W, 3) frames as a movie at `fps` frames a second, looping."""
+def check_rate(path: str, frames: int, fps: float) -> None:
+    """Refuse a movie whose frames would last longer than its format can say (a tiny fps)."""
     fmt = movie_format(path)
+    if not 1000 / fps <= MAX_DELAY[fmt] or max(delays(frames, fps, TICK[fmt])) > MAX_DELAY[fmt]:
+        raise RtcliError(f"-o {shown(path)}: at {fps:g} fps a frame lasts {1 / fps:g} s, longer than the "
+                         f"{MAX_DELAY[fmt] / 1000:g} s a frame of {KIND[fmt]} can last; give a higher fps, or "
+                         "write the frames to files (frame_%04d.png)")
+
+
+def _check_runs(path: str, frames: list[np.ndarray], durations: list[int]) -> None:
+    """Refuse a GIF whose identical frames in a row (which a GIF holds as one) last too long."""
+    first, total = 0, 0
+    for k, frame in enumerate(frames):
+        if k and not np.array_equal(frame, frames[k - 1]):
+            first, total = k, 0
+        total += durations[k]
+        if total > MAX_DELAY["GIF"]:
+            raise RtcliError(f"-o {shown(path)}: frames {first + 1}-{k + 1} are the same picture, which a GIF "
+                             f"holds as one frame of {total / 1000:g} s, longer than the "
+                             f"{MAX_DELAY['GIF'] / 1000:g} s it can last; write an animated PNG (.apng)")
+
+
+def write_movie(path: str, frames: list[np.ndarray], fps: float, meta: dict[str, str] | None = None) -> None:
+    """Write uint8 (H, W, 3) frames as a movie at `fps` frames a second, looping; `meta`, the
+    provenance (rendering/provenance.py), as an APNG's text chunks or a GIF's comment (JSON)."""
+    fmt = movie_format(path)
+    check_rate(path, len(frames), fps)
+    durations = delays(len(frames), fps, TICK[fmt])
+    if fmt == "GIF":
+        _check_runs(path, frames, durations)
     images = [Image.fromarray(f) for f in frames]
+    extra = {}
+    if meta and fmt == "PNG":
+        extra["pnginfo"] = PngInfo()
+        for key, value in meta.items():
+            extra["pnginfo"].add_text(key, value)
+    elif meta:
+        extra["comment"] = provenance.as_json(meta).encode("utf-8")
     write_atomic(path, lambda f: images[0].save(f, format=fmt, save_all=True, append_images=images[1:],
-                                                duration=delays(len(images), fps, TICK[fmt]), loop=0))
+                                                duration=durations, loop=0, **extra))
 
 
 def delays(frames: int, fps: float, tick: int) -> list[int]:

@@ -11,6 +11,7 @@ worker outlives a parent that was killed outright.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import signal
 import threading
 import time
@@ -41,14 +42,45 @@ def held_signals():
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
+@contextlib.contextmanager
+def interrupted_once():
+    """While the block runs (a pool's life, its stop included), the first SIGINT or SIGTERM goes to
+    the handler that was there (the command line's raises Interrupted, Python's KeyboardInterrupt)
+    and any later one is ignored. A second signal (Ctrl-C, then a supervisor's SIGTERM) would
+    otherwise raise again while the first unwinds: half way through the release of a lock of
+    threading (`RuntimeError: release unlocked lock`), or through the pool's shutdown, with a
+    traceback or a hang. Stopping the pool is bounded (stop_pool), so ignoring is safe."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.getsignal(s) for s in HELD}
+    wrapped = {s: h for s, h in previous.items() if callable(h)}
+    fired: list[int] = []
+
+    def once(signum, frame):
+        if not fired:
+            fired.append(signum)
+            wrapped[signum](signum, frame)
+    for s in wrapped:
+        signal.signal(s, once)
+    try:
+        yield
+    finally:
+        for s, h in wrapped.items():
+            signal.signal(s, h)
+
+
 def watch_worker() -> None:
     """In a worker: ignore SIGINT (the parent handles it), take SIGTERM again (it was forked while
-    the parent held it) and die when the parent dies."""
+    the parent held it) and die when the parent dies. SIGTERM ends a worker at once, by its
+    default action: the handler forked from the parent (cli.py's, which raises Interrupted) would
+    print a traceback from the worker when the signal came while it starts or waits for a tile;
+    the parent reports the death as the interrupt it is (worker_died)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)
     try:
-        import ctypes
         ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
     except (OSError, AttributeError):            # not Linux: the parent's stop_pool still applies
         pass
@@ -59,7 +91,14 @@ def _processes(pool) -> list:
 
 
 def stop_pool(pool, finished: bool) -> None:
-    """Shut the pool down; unless every tile is done, cancel the rest and kill the workers first."""
+    """Shut the pool down; unless every tile is done, cancel the rest and kill the workers first.
+
+    Either way the pool's manager thread has ended on return (within a bound when the workers
+    were killed). Left running, it closes its wake-up pipe while the interpreter's exit
+    (concurrent.futures' _python_exit, which takes no lock) may be writing to it: an
+    `OSError: [Errno 9] Bad file descriptor` traceback after rtcli's own `error: interrupted`,
+    now and then, when a signal reached the parent alone.
+    """
     if finished:
         pool.shutdown(wait=True)
         return
@@ -67,9 +106,12 @@ def stop_pool(pool, finished: bool) -> None:
     for p in workers:
         if p.exitcode is None:
             p.kill()
+    manager = getattr(pool, "_executor_manager_thread", None)
     pool.shutdown(wait=False, cancel_futures=True)
     for p in workers:
         p.join(timeout=5)
+    if manager is not None:
+        manager.join(timeout=5)                 # the workers are dead: it sees the pool broken and ends
 
 
 def _exit_codes(workers: list, wait: float = 1.0) -> list[int]:

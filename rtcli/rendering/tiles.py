@@ -20,11 +20,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rtcli.core.display import to_8bit
+from rtcli.core.display import to_8bit, to_8bit_alpha
 from rtcli.core.jitter import sample_positions
+from rtcli.core.objects import object_ids
 from rtcli.core.scene import Scene
 from rtcli.rendering import engine as engines
-from rtcli.rendering.pool import held_signals, stop_pool, watch_worker, worker_died
+from rtcli.rendering.pool import held_signals, interrupted_once, stop_pool, watch_worker, worker_died
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit
 from rtcli.wavefront.rays import camera_rays
@@ -46,6 +47,7 @@ class Job:
     engine: str = "auto"             # auto, numpy or compiled (rtcli/rendering/engine.py)
     bvh: bool = True                 # a BVH over the scene's objects when there are enough (Scene.wants_bvh)
     linear: bool = False             # keep the traced colors (float64, unclamped) instead of 8 bits
+    alpha: bool = False              # a fourth channel: the share of each pixel's samples that hit an object
 
 
 def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
@@ -60,7 +62,7 @@ def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
             rays = camera_rays(cam, i + 0.5, j + 0.5, job.width, job.height)
             hits = find_first_hit(scene, rays)
             stats.primary += len(rays)
-            ids = np.array([o.id for o in scene.objects] + [0], dtype=np.uint16)
+            ids = object_ids(scene.objects)
             return ids[hits.obj], stats
         xs, ys = sample_positions(i, j, scene.settings.samples)
         stats.primary += xs.size
@@ -69,7 +71,22 @@ def render_tile(scene: Scene, job: Job, i: np.ndarray, j: np.ndarray,
         else:
             colors = trace(scene, camera_rays(cam, xs.ravel(), ys.ravel(), job.width, job.height), 1, stats).T
     colors = colors.reshape(len(xs), len(i), 3)
+    if job.alpha:
+        return with_alpha(scene, cam, job, xs, ys, colors), stats
     return colors.mean(axis=0), stats
+
+
+def with_alpha(scene: Scene, cam, job: Job, xs: np.ndarray, ys: np.ndarray, colors: np.ndarray) -> np.ndarray:
+    """(n, 4): the straight color of each pixel (the mean of its samples that hit an object, 0 when
+    none does) and its alpha (the share of its samples that hit one). The primary rays are traced
+    again by the numpy engine for their hits, whichever engine traced the colors (the same hits,
+    bit for bit). A pixel whose samples all hit has the color it has without alpha, to the bit."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        hits = find_first_hit(scene, camera_rays(cam, xs.ravel(), ys.ravel(), job.width, job.height))
+    hit = np.isfinite(hits.t).reshape(colors.shape[:2])
+    count = hit.sum(axis=0)
+    straight = np.where(hit[..., None], colors, 0.0).sum(axis=0) / np.maximum(count, 1)[:, None]
+    return np.concatenate([straight, (count / hit.shape[0])[:, None]], axis=1)
 
 
 def _tiles(job: Job, samples: int = 1):
@@ -90,7 +107,7 @@ def _run_tile(scene: Scene, engine, job: Job, rows: np.ndarray, cols: np.ndarray
     jj, ii = np.meshgrid(rows, cols, indexing="ij")
     values, stats = render_tile(scene, job, ii.ravel(), jj.ravel(), engine)
     if not (job.signature or job.linear):
-        values = to_8bit(values, job.gamma)
+        values = to_8bit_alpha(values, job.gamma) if job.alpha else to_8bit(values, job.gamma)
     return rows, cols, values.reshape(len(rows), len(cols), *values.shape[1:]), stats
 
 
@@ -140,9 +157,9 @@ def assemble(job: Job, count: int, results, stats: Stats, progress=None) -> np.n
 
 
 def blank(job: Job) -> np.ndarray:
-    """The job's image before any tile is placed: 8-bit RGB, 16-bit ids for a signature, or
-    float64 colors with job.linear."""
-    shape = (job.height, job.width) + (() if job.signature else (3,))
+    """The job's image before any tile is placed: 8-bit RGB (RGBA with job.alpha), 16-bit ids for a
+    signature, or float64 colors with job.linear."""
+    shape = (job.height, job.width) + (() if job.signature else (4,) if job.alpha else (3,))
     return np.zeros(shape, dtype=np.uint16 if job.signature else np.float64 if job.linear else np.uint8)
 
 
@@ -172,13 +189,14 @@ def _map_tiles(scene: Scene, engine, job: Job, tiles: list, workers: int):
     context = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(scene, engine))
     finished = False
-    try:
-        with held_signals():                    # an interrupt inside submit() could hang the exit
-            futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
-        for f in as_completed(futures):
-            yield f.result()
-        finished = True
-    except BrokenProcessPool:
-        raise worker_died(pool) from None
-    finally:
-        stop_pool(pool, finished)
+    with interrupted_once():                    # a second signal would break the unwinding of the first
+        try:
+            with held_signals():                # an interrupt inside submit() could hang the exit
+                futures = [pool.submit(_worker_tile, job, rows, cols) for rows, cols in tiles]
+            for f in as_completed(futures):
+                yield f.result()
+            finished = True
+        except BrokenProcessPool:
+            raise worker_died(pool) from None
+        finally:
+            stop_pool(pool, finished)

@@ -3,20 +3,20 @@
 The compiled engine calls one entry point, the integrator (trace_camera); the numpy engine
 calls two compiled walks, over a mesh's triangles and over a BVH of spheres. Each is called
 here once, through the engines' own code on two small scenes made in code, so with the same
-argument types as in any render: afterwards no render compiles (tests/test_startup.py renders
+argument types as in any render: afterwards no render compiles (tests/compiled/test_startup.py renders
 every scene and checks that). A second warmup loads the code from the cache in well under a
 second and says that nothing was compiled.
 """
 
 from __future__ import annotations
 
+import compileall
 import time
 from functools import partial
 
 import numpy as np
 
 from rtcli import wavefront
-from rtcli.kernels import numba_cache, variants
 from rtcli.compiled import ENTRY, compiled_integrator
 from rtcli.compiled import build as compiled_build
 from rtcli.compiled.loading import Load
@@ -26,7 +26,7 @@ from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
 from rtcli.core.scene import Scene, SceneObject
 from rtcli.errors import RtcliError
-from rtcli.kernels import machinecode
+from rtcli.kernels import machinecode, numba_cache, variants
 from rtcli.rendering.engine import choose
 from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.plane import Plane
@@ -87,5 +87,4 @@ def bytecode() -> bool:
     """Compile rtcli's Python files to bytecode where Python keeps it (each folder's __pycache__),
     so that no run compiles them again (a run that may not write bytecode, PYTHONDONTWRITEBYTECODE,
     would every time); whether that worked."""
-    import compileall
     return bool(compileall.compile_dir(numba_cache.PACKAGE_DIR, quiet=2))

@@ -1,8 +1,12 @@
 """Images out: files written atomically, in the format their names ask for.
 
 The format follows the output's extension (FORMATS: PNG, and JPEG, BMP, TIFF,
-WebP, PPM for pictures), so a .jpg name never receives PNG bytes. Files carry
-no timestamp or other metadata, so the same pixels always give the same bytes.
+WebP, PPM for pictures; EXR and PFM for linear floats), so a .jpg name never
+receives PNG bytes. 8-bit images go through Pillow; 16-bit PNG and TIFF through
+deep.py, EXR through exr.py, PFM through pfm.py. An image may carry its provenance
+(rendering/provenance.py: PNG text chunks, EXR header attributes, JSON in the TIFF,
+JPEG and WebP description); the same pixels and provenance give the same bytes, so
+two renders' files differ by their render time: compare pixels, not bytes.
 Files are written to a temporary name in the target folder and renamed into
 place, several outputs all or none, so a failed or interrupted run never leaves
 a truncated image, nor one output without the other.
@@ -15,10 +19,15 @@ import tempfile
 
 import numpy as np
 from PIL import Image
+from PIL.PngImagePlugin import PngInfo
 
 from rtcli.errors import RtcliError, quoted, shown
+from rtcli.rendering import provenance
+from rtcli.rendering.deep import write_png16, write_tiff16
+from rtcli.rendering.exr import write_exr
+from rtcli.rendering.pfm import write_pfm
 
-# extension -> (Pillow format, save options); 16-bit id maps go to PNG only
+# extension -> (Pillow format, save options); 16-bit id maps go to PNG only; EXR and PFM are rtcli's own
 FORMATS = {
     ".png": ("PNG", {"compress_level": 3}),      # zlib's 6 takes twice as long for 13% fewer bytes
     ".jpg": ("JPEG", {"quality": 95}),
@@ -28,7 +37,12 @@ FORMATS = {
     ".tiff": ("TIFF", {}),
     ".webp": ("WEBP", {"lossless": True}),
     ".ppm": ("PPM", {}),
+    ".exr": ("EXR", {}),
+    ".pfm": ("PFM", {}),
 }
+FLOATS = (".exr", ".pfm")                          # linear radiance as floats
+DEEP = (".png", ".tif", ".tiff")                   # 16 bits a channel (--bit-depth 16)
+ALPHA = (".png", ".tif", ".tiff", ".webp", ".exr")     # an alpha channel (render: {alpha: true})
 
 
 def image_format(path: str, ids: bool = False) -> tuple[str, dict]:
@@ -43,19 +57,19 @@ def image_format(path: str, ids: bool = False) -> tuple[str, dict]:
     return FORMATS[ext]
 
 
-def write_png(path: str, pixels: np.ndarray) -> None:
+def write_png(path: str, pixels: np.ndarray, meta: dict[str, str] | None = None) -> None:
     """Write one image atomically, in the format its extension names (see write_images)."""
-    write_images([(path, pixels)])
+    write_images([(path, pixels, meta)])
 
 
-def write_images(items: list[tuple[str, np.ndarray]]) -> None:
-    """Write uint8 (H, W, 3) as RGB or uint16 (H, W) as 16-bit gray, each in the format of its
-    extension, all or none: every image goes to a temporary file in its folder first, and
-    only when all are written are they renamed into place; on any failure, or an
-    interrupt, the temporary files and any image already renamed are removed."""
+def write_images(items: list[tuple]) -> None:
+    """Write each (path, pixels) or (path, pixels, provenance) in the format of its extension (see
+    Staged.add for the pixels each takes), all or none: every image goes to a temporary file
+    in its folder first, and only when all are written are they renamed into place; on any
+    failure, or an interrupt, the temporary files and any image already renamed are removed."""
     with Staged() as staged:
-        for path, pixels in items:
-            staged.add(path, pixels)
+        for path, pixels, *meta in items:
+            staged.add(path, pixels, *meta)
         staged.commit()
 
 
@@ -71,9 +85,14 @@ class Staged:
     def __enter__(self) -> "Staged":
         return self
 
-    def add(self, path: str, pixels: np.ndarray) -> None:
+    def add(self, path: str, pixels: np.ndarray, meta: dict[str, str] | None = None, layers: dict | None = None,
+            half: bool = False) -> None:
+        """Stage one image: uint8 (H, W, 3 or 4) in any format (4 channels: RGBA, in ALPHA's), uint16
+        (H, W) as a 16-bit gray PNG (an id map), uint16 (H, W, 3 or 4) as a 16-bit PNG or TIFF,
+        float (H, W, 3 or 4) linear colors with straight alpha as EXR (float16 with `half`, the views'
+        data in `layers` as its layers) or PFM; `meta`, the provenance, where the format has room."""
         try:
-            self.temps.append((_write_temp(path, pixels), path))
+            self.temps.append((_write_temp(path, pixels, meta, layers, half), path))
         except OSError as e:
             raise RtcliError(f"cannot write {shown(path)}: {e.strerror or e}") from None
 
@@ -93,14 +112,49 @@ class Staged:
             _remove(path)
 
 
-def _write_temp(path: str, pixels: np.ndarray) -> str:
+def _write_temp(path: str, pixels: np.ndarray, meta=None, layers=None, half: bool = False) -> str:
     """The image written to a new temporary file beside `path`; its name."""
-    if not ((pixels.dtype == np.uint16 and pixels.ndim == 2)
-            or (pixels.dtype == np.uint8 and pixels.ndim == 3 and pixels.shape[2] == 3)):
-        raise ValueError(f"cannot write {pixels.dtype} pixels of shape {pixels.shape} as an image")
-    fmt, options = image_format(path, ids=pixels.dtype == np.uint16)
-    img = Image.fromarray(pixels)                      # uint16 (H, W) -> I;16, uint8 (H, W, 3) -> RGB
+    fmt, options = image_format(path, ids=pixels.dtype == np.uint16 and pixels.ndim == 2)
+    _check_pixels(path, fmt, pixels)
+    if fmt == "EXR":
+        return write_temp(path, lambda f: write_exr(f, pixels, layers, meta, half))
+    if fmt == "PFM":
+        return write_temp(path, lambda f: write_pfm(f, pixels))
+    if pixels.dtype == np.uint16 and pixels.ndim == 3:
+        return write_temp(path, lambda f: (write_png16 if fmt == "PNG" else write_tiff16)(f, pixels, meta))
+    img = Image.fromarray(pixels)                      # uint16 (H, W) -> I;16, uint8 (H, W, 3|4) -> RGB(A)
+    options = {**options, **_meta_options(fmt, meta)} if meta else options
     return write_temp(path, lambda f: img.save(f, format=fmt, **options))
+
+
+def _check_pixels(path: str, fmt: str, pixels: np.ndarray) -> None:
+    """ValueError for pixels the format cannot take (the callers check what users ask for)."""
+    ext = os.path.splitext(path)[1].lower()
+    channels = pixels.shape[2] if pixels.ndim == 3 else 0
+    fits = (pixels.dtype.kind == "f" and ext in FLOATS and channels in (3, 4) and (fmt == "EXR" or channels == 3)
+            or pixels.dtype == np.uint16 and (channels == 0 or ext in DEEP and channels in (3, 4))
+            or pixels.dtype == np.uint8 and ext not in FLOATS and (channels == 3 or channels == 4 and ext in ALPHA))
+    if not fits:
+        raise ValueError(f"cannot write {pixels.dtype} pixels of shape {pixels.shape} as {fmt}")
+
+
+def _meta_options(fmt: str, meta: dict[str, str]) -> dict:
+    """Pillow's save options that carry the provenance: PNG text chunks, or JSON as the TIFF's,
+    JPEG's or WebP's image description (EXIF); BMP and PPM have no place for it."""
+    if fmt == "PNG":
+        info = PngInfo()
+        for key, value in meta.items():
+            info.add_text(key, value)
+        return {"pnginfo": info}
+    if fmt == "TIFF":
+        return {"tiffinfo": {provenance.DESCRIPTION: provenance.as_json(meta),
+                             provenance.SOFTWARE_TAG: provenance.software(meta)}}
+    if fmt in ("JPEG", "WEBP"):
+        exif = Image.Exif()
+        exif[provenance.DESCRIPTION] = provenance.as_json(meta)
+        exif[provenance.SOFTWARE_TAG] = provenance.software(meta)
+        return {"exif": exif.tobytes()}
+    return {}
 
 
 def write_temp(path: str, save) -> str:

@@ -17,6 +17,7 @@ from rtcli.core import camera as cameras
 from rtcli.core.elementary import cos
 from rtcli.core.lights import PointLight
 from rtcli.core.materials import Material, MaterialTable
+from rtcli.core.objects import kind_counts
 from rtcli.core.scene import Scene, Settings
 from rtcli.core.vec import unit3
 from rtcli.errors import SceneError, plural
@@ -109,6 +110,8 @@ def _top_level(p: Params, builder: ObjectBuilder, lights, table) -> Scene:
         settings.epsilon = r.number("epsilon", 1e-6, positive=True)
         settings.medium_ior = r.number("medium_ior", 1.0, positive=True)
         settings.total_internal_reflection = r.choice("total_internal_reflection", ("drop", "reflect"), "drop")
+        settings.alpha = r.boolean("alpha", False)
+        settings.shadow_terminator = r.choice("shadow_terminator", ("none", "offset"), "none")
         r.check_unused()
     camera, eye = camera_from(p.sub("camera"))
     check_resolvable(p, camera, settings.width, settings.height)
@@ -218,10 +221,7 @@ def light_from(p: Params) -> PointLight:
 def summary(scene: Scene) -> str:
     """One line for `rtcli validate`."""
     s = scene.settings
-    kinds = {}
-    for o in scene.objects:
-        kinds[o.kind] = kinds.get(o.kind, 0) + 1
-    shapes = ", ".join(f"{n} {k}" for k, n in kinds.items())
+    shapes = ", ".join(f"{n} {k}" for k, n in kind_counts(scene.objects).items())
     return (f"{plural(len(scene.objects), 'object')} ({shapes or 'none'}), {plural(len(scene.lights), 'light')}, "
             f"{plural(len(scene.materials) - 1, 'material')}; {s.width}x{s.height}, max_depth {s.max_depth}, "
             f"{s.specular}, samples {s.samples}")

@@ -37,6 +37,9 @@ _served: contextvars.ContextVar[dict | None] = contextvars.ContextVar("rtcli_ser
 _stamps: contextvars.ContextVar[dict | None] = contextvars.ContextVar("rtcli_stamps", default=None)
 
 
+NUL = "a path cannot hold a NUL byte"
+
+
 class InputError(OSError):
     """A path that names no readable regular file of an allowed size; strerror says why
     (without the path, as OSError's strerror)."""
@@ -49,13 +52,20 @@ class InputError(OSError):
         return self.strerror
 
 
+def has_nul(path) -> bool:
+    """Whether a path (str, bytes or os.PathLike) holds a NUL byte, which no file name can."""
+    name = os.fspath(path)
+    return ("\0" if isinstance(name, str) else b"\0") in name
+
+
 def kind_of(mode: int) -> str:
     """'a folder', 'a FIFO (named pipe)', ... for a file mode that is not a regular file."""
     return next((name for test, name in _KINDS if test(mode)), "a special file")
 
 
 def check_input(path: str, limit: int) -> int:
-    """The size of the regular file at `path`; InputError (or FileNotFoundError) otherwise.
+    """The size of the regular file at `path`; InputError (or FileNotFoundError) otherwise (a
+    path with a NUL byte, which no file has, is an InputError too).
 
     Uses os.stat, which never opens the file, so a FIFO or a device is refused
     before anything could block on it or read it without end.
@@ -68,6 +78,8 @@ def check_input(path: str, limit: int) -> int:
         if len(data) > limit:
             raise InputError(f"too large: {len(data) / MB:.1f} MB, more than the {limit // MB} MB allowed")
         return len(data)
+    if has_nul(path):
+        raise InputError(NUL)
     try:
         st = os.stat(path)
     except FileNotFoundError:
@@ -103,7 +115,10 @@ def read_bytes(path: str, limit: int) -> bytes:
 
 
 def real_path(path: str) -> str:
-    """The file's real path (links resolved), as the machine that read it saw it when it is served."""
+    """The file's real path (links resolved), as the machine that read it saw it when it is served;
+    a path with a NUL byte as it is (no file has it: reading it is the error, check_input)."""
+    if has_nul(path):
+        return path
     served = _served.get()
     if served is not None and path in served:
         return served[path][0]

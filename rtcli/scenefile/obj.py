@@ -16,6 +16,7 @@ Numbers are converted in bulk by numpy; only the split into lines is a loop.
 from __future__ import annotations
 
 import re
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,7 +24,7 @@ import numpy as np
 from rtcli.errors import SceneError, Where, quoted
 from rtcli.scenefile import obj_bulk
 from rtcli.scenefile.files import read_bytes
-from rtcli.scenefile.limits import MAX_MESH_BYTES
+from rtcli.scenefile.limits import MAX_MAGNITUDE, MAX_MESH_BYTES, RANGE
 
 _READ = {"v": 3, "vt": 1, "vn": 3}      # statement -> how many numbers it needs at least
 _KEEP = {"v": 3, "vt": 2, "vn": 3}      # statement -> how many numbers are kept (vt's v defaults to 0)
@@ -56,11 +57,12 @@ class _Source:
         return SceneError(Where(self.display, line_no, column), "", message)
 
 
-def parse_obj(text: str, display: str) -> ObjData:
-    """Parse OBJ text; `display` names the file in error messages."""
+def parse_obj(text: str, display: str, bound: float = sys.float_info.max) -> ObjData:
+    """Parse OBJ text; `display` names the file in error messages; a number beyond +-`bound` is
+    an error (read_obj's bound is a scene's, +-MAX_MAGNITUDE)."""
     lines = text.splitlines()
     src, found = _Source(display, lines), _statements(lines)
-    v, vt, vn = (_numbers(src, kw, *found[kw]) for kw in ("v", "vt", "vn"))
+    v, vt, vn = (_numbers(src, kw, *found[kw], bound) for kw in ("v", "vt", "vn"))
     line_of_f, args_of_f = found["f"]
     faces = np.zeros((0, 3), np.int64), np.zeros((0, 3), np.int64), np.zeros((0, 3), np.int64)
     if line_of_f:
@@ -80,11 +82,15 @@ def read_obj(path: str, display: str | None = None) -> ObjData:
 
 def parse_obj_bytes(data: bytes, display: str) -> ObjData:
     """An OBJ file's bytes: by the bulk reader (obj_bulk.py) when it can, else by parse_obj,
-    which gives the same arrays and names any error at its line and column."""
+    which gives the same arrays and names any error at its line and column. Every number lies
+    within +-MAX_MAGNITUDE, as a scene's (docs/scene-format.md, Limits): a vertex at 1e300
+    would overflow the triangles' arithmetic."""
     bulk = obj_bulk.parse(data)
     if bulk is None:
-        return parse_obj(data.decode("utf-8", errors="replace"), display)
+        return parse_obj(data.decode("utf-8", errors="replace"), display, MAX_MAGNITUDE)
     v, vt, vn, faces, uv_faces, normal_faces = bulk
+    if any(a.size and (a.max() > MAX_MAGNITUDE or a.min() < -MAX_MAGNITUDE) for a in (v, vt, vn)):
+        parse_obj(data.decode("utf-8", errors="replace"), display, MAX_MAGNITUDE)     # names the number
     return ObjData(v, faces, vt, uv_faces, vn, normal_faces)
 
 
@@ -102,8 +108,8 @@ def _statements(lines: list[str]) -> dict[str, tuple[list[int], list[list[str]]]
     return found
 
 
-def _numbers(src: _Source, kw: str, line_nos: list[int], args: list[list[str]]) -> np.ndarray:
-    """(k, 2 or 3) array of the leading numbers of every `kw` statement, all finite."""
+def _numbers(src: _Source, kw: str, line_nos: list[int], args: list[list[str]], bound: float) -> np.ndarray:
+    """(k, 2 or 3) array of the leading numbers of every `kw` statement, all finite and within +-bound."""
     need, keep = _READ[kw], _KEEP[kw]
     for no, a in zip(line_nos, args):
         if len(a) < need:
@@ -113,11 +119,13 @@ def _numbers(src: _Source, kw: str, line_nos: list[int], args: list[list[str]]) 
         out = np.array(flat, dtype=float).reshape(-1, keep)
     except ValueError:
         out = None
-    if out is None or not np.isfinite(out).all():
+    if out is None or not (np.abs(out) <= bound).all():                # NaN and infinities fail it too
         for no, a in zip(line_nos, args):
             for k, x in enumerate(a[:keep]):
                 if not _finite(x):
                     raise src.error(no, k, f"bad number {quoted(x)} in '{kw}'")
+                if abs(float(x)) > bound:
+                    raise src.error(no, k, f"number {x} in '{kw}' must be {RANGE}")
     return out
 
 

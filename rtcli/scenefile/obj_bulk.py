@@ -15,7 +15,7 @@ reader, then reads the file and names any error at its line and column: bytes ot
 than printable ASCII, tabs and line ends outside comments, a line break that is not
 \\n or \\r\\n, a number in another form, a face corner that is not v, v/vt, v//vn or
 v/vt/vn with plain indices, and every error (a statement short of numbers, an index
-out of range or 0). tests/test_obj_bulk.py checks that both readers give the same
+out of range or 0). tests/scenefile/test_obj_bulk.py checks that both readers give the same
 arrays. The file is read in blocks of whole lines, and tokens converted in pieces, so
 that the masks and tables stay small beside the file (docs/scene-format.md, Limits).
 """

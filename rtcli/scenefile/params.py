@@ -18,6 +18,7 @@ from rtcli.scenefile.hints import NOTES_NAMES, misspells, unknown_key_hint
 from rtcli.scenefile.limits import MAX_MAGNITUDE
 from rtcli.scenefile.nodes import MapNode, SeqNode
 from rtcli.scenefile.remarks import note_color
+from rtcli.scenefile.yamlbulk import SphereRun
 from rtcli.scenefile.values import channel_problem, describe, finite_numbers, is_number, out_of_range
 
 REQUIRED = object()
@@ -237,7 +238,12 @@ class Params:
             return []
         if not isinstance(x, SeqNode):
             raise self.error(key, f"must be a list, got {describe(x)}")
-        return [(v, x.item_where[k], f"{self.key_path(key)}[{k}]") for k, v in enumerate(x)]
+        out, skip = [], 0                       # a run of spheres read in bulk is one item of many
+        for k, v in enumerate(x):
+            out.append((v, x.item_where[k], f"{self.key_path(key)}[{k + skip}]"))
+            if type(v) is SphereRun:
+                skip += len(v) - 1
+        return out
 
 
 def _plain_numbers(x) -> bool:

@@ -8,7 +8,7 @@ and a message names `<dict>` and the key path alone:
 `<dict>: objects[1].sphere.radius: must be > 0, got -1`.
 
 Tuples count as lists; numpy arrays and numpy numbers, as the lists and numbers they
-hold; os.PathLike values (pathlib.Path for a texture or a mesh), as strings. Keys
+hold, but for an object's `spheres` and a `mesh` given by `vertices`, kept as arrays (arrays.py); os.PathLike values (pathlib.Path for a texture or a mesh), as strings. Keys
 are strings (numbers and booleans become strings, as YAML keys do). Any other value,
 a dict or list that contains itself, or nesting deeper than MAX_DEPTH is an error at
 its key path. A value that appears twice is converted once, as a YAML alias is.
@@ -22,6 +22,7 @@ from array import array
 import numpy as np
 
 from rtcli.errors import SceneError, Where, shown
+from rtcli.scenefile.arrays import arrays_of, wants_arrays
 from rtcli.scenefile.limits import MAX_DEPTH
 from rtcli.scenefile.nodes import MapNode, SeqNode, size_of
 
@@ -66,7 +67,11 @@ class _Converter:
         node.file, node.folder, node.duplicates, node._index, node.size = DICT, self.folder, (), None, 1
         for key, item in x.items():
             name = _key(key, path)
-            node[name] = self.value(item, f"{path}.{shown(name)}" if path else shown(name), depth + 1)
+            here = f"{path}.{shown(name)}" if path else shown(name)
+            if path.endswith("]") and wants_arrays(name, item):         # an object's set of arrays
+                node[name] = arrays_of(name, item, here)
+                continue
+            node[name] = self.value(item, here, depth + 1)
             node.size += size_of(node[name])
         node.places = array("Q", bytes(8 * (1 + 2 * len(node))))
         return node

@@ -24,6 +24,7 @@ import re
 import yaml
 
 from rtcli.errors import SceneError, Where, shown
+from rtcli.scenefile import yamlbulk
 from rtcli.scenefile.files import read_bytes, real_path
 from rtcli.scenefile.limits import MAX_INCLUDE_DEPTH, MAX_SCENE_BYTES
 from rtcli.scenefile.nodes import MapNode, SeqNode
@@ -36,7 +37,20 @@ _UNQUOTED_COLOR = re.compile(r"(?:^|[\s\[{,:-])(#[0-9a-fA-F]{6})\b")
 
 
 def parse(text: str, display: str, folder: str = ".") -> MapNode:
-    """Parse one YAML document whose top level must be a mapping."""
+    """Parse one YAML document whose top level must be a mapping; runs of spheres written one a
+    line are read in bulk (yamlbulk.py), any error found again the usual way."""
+    short, runs = yamlbulk.extract(text)
+    if runs:
+        try:
+            tree = _parse(short, display, folder)
+        except SceneError:
+            tree = None
+        if tree is not None and yamlbulk.place(tree, runs):
+            return tree
+    return _parse(text, display, folder)
+
+
+def _parse(text: str, display: str, folder: str) -> MapNode:
     loader = Loader(text)
     try:
         tree = Builder(loader, display, folder, text).document()

@@ -121,6 +121,10 @@ class Shape:
             u, v = self.kernels.uv(self.row, self.pool, prim, *p)
         return np.broadcast_to(u, p[0].shape), np.broadcast_to(v, p[0].shape)
 
+    def texture_points(self, p, prim):
+        """The points (3, n) where a checker is evaluated: p itself (a csg's: its leaves' own spaces)."""
+        return p
+
     def spans_of(self, o, d):
         """(t_in, prim_in, t_out, prim_out), each (n, SPANS): the intervals inside the solid."""
         n = o.shape[1]

@@ -12,7 +12,8 @@ YAML: `csg: {difference: [object, object, ...]}` (or `union:` / `intersection:`)
 children are objects (with `transform:` and `material:`, no `name` needed);
 difference = first child minus all the others. Children must be solids: sphere,
 plane (the half-space behind its normal), box, cylinder, cone, torus or csg.
-The checker texture of a csg is evaluated in the csg's own object space.
+A checker is evaluated in the own space of the leaf hit (the child's, before its transform),
+as for a group's child, whether the material is the child's or the csg's.
 
 The span algebra is written once, for both engines: a span's two boundaries
 (`boundaries`), their order along the ray (`precedes`) and the boolean rule
@@ -234,6 +235,11 @@ class CSG(Shape):
     def uv_at(self, p, prim):
         uv = self._per_child(p, prim, lambda c, child, p_c, cp: np.stack(child.shape.uv_at(p_c, cp)))
         return uv[0], uv[1]
+
+    def texture_points(self, p, prim):
+        """Each hit taken into its leaf's own space (before the leaf's `transform:`), child by child,
+        where a checker is evaluated, as for any object (docs/scene-format.md, Textures)."""
+        return self._per_child(p, prim, lambda c, child, p_c, cp: child.shape.texture_points(p_c, cp))
 
     def material_of(self, prim, default: int):
         """Each hit's material: the child's (a nested csg asks its own children).

@@ -18,7 +18,7 @@ import numpy as np
 
 from rtcli.core.vec import cross, cross3, dot, length3, unit3
 from rtcli.shapes.base import POOL_WIDTH, Param, ParamError, Shape, ShapeKernels
-from rtcli.kernels.variants import INF, isnan, kernel, not_, per_ray, select, sqrt, to_int
+from rtcli.kernels.variants import INF, isnan, kernel, minimum, not_, per_ray, select, sqrt, to_int
 
 # a pool row: corner a, edges e1 and e2, face normal, corner normals na, nb, nc, corner (u, v)s
 A, E1, E2, FACE, NA, NB, NC, UVA, UVB, UVC = 0, 3, 6, 9, 12, 15, 18, 21, 23, 25
@@ -61,6 +61,34 @@ def corners(pool, j, at, size, alpha, beta):
     """(1 - alpha - beta) c_a + alpha c_b + beta c_c for the corner values at pool[j, at:],
     each `size` long (component 0 of them; add to `at` for the others)."""
     return (1 - alpha - beta) * pool[j, at] + alpha * pool[j, at + size] + beta * pool[j, at + 2 * size]
+
+
+@kernel
+def below(pool, j, at, qx, qy, qz):
+    """min(0, q . n) n, n the corner normal at pool[j, at:] and q the offset of a point from that
+    corner: how far the point lies below the corner's tangent plane, along n (0 on or above it)."""
+    nx, ny, nz = pool[j, at], pool[j, at + 1], pool[j, at + 2]
+    h = minimum(dot(qx, qy, qz, nx, ny, nz), 0.0)
+    return h * nx, h * ny, h * nz
+
+
+@kernel
+def terminator(s, pool, prim, x, y, z):
+    """Hanika's shadow-terminator shift at the point (x, y, z) of a smooth face (Ray Tracing Gems
+    II, ch. 4): the point projected onto each corner's tangent plane where it lies below it, the
+    three blended by the barycentric weights, minus the point; (0, 0, 0) on a flat face
+    (docs/scene-format.md, Shadow terminator)."""
+    j = to_int(s[FIRST]) + prim
+    if s[SMOOTH] == 0:
+        return 0.0, 0.0, 0.0
+    alpha, beta = barycentric(pool, j, x, y, z)
+    gamma = 1 - alpha - beta
+    ax, ay, az = pool[j, A], pool[j, A + 1], pool[j, A + 2]
+    ux, uy, uz = below(pool, j, NA, x - ax, y - ay, z - az)
+    vx, vy, vz = below(pool, j, NB, x - (ax + pool[j, E1]), y - (ay + pool[j, E1 + 1]), z - (az + pool[j, E1 + 2]))
+    wx, wy, wz = below(pool, j, NC, x - (ax + pool[j, E2]), y - (ay + pool[j, E2 + 1]), z - (az + pool[j, E2 + 2]))
+    return (-(gamma * ux + alpha * vx + beta * wx), -(gamma * uy + alpha * vy + beta * wy),
+            -(gamma * uz + alpha * vz + beta * wz))
 
 
 @kernel

@@ -7,6 +7,7 @@ the shared kernels of rtcli/core/ and rtcli/shapes/, run on whole arrays.
 
 from __future__ import annotations
 
+from rtcli.core.objects import singles
 from rtcli.shapes.mesh import Mesh
 from rtcli.wavefront.accel import Accelerator
 
@@ -19,7 +20,7 @@ def prepare(scene, bvh: bool = True, walks=None, levels=None) -> None:
     (rendering/engine.py) says which; this engine imports neither."""
     scene.walks = walks
     build(scene, bvh, levels)
-    for o in scene.objects:                 # each mesh's tree, built once here, not in every worker
+    for _, o in singles(scene.objects):     # each mesh's tree, built once here, not in every worker
         if isinstance(o.shape, Mesh):
             o.shape.tree(levels)
 
@@ -35,5 +36,5 @@ def build(scene, bvh: bool = True, levels=None) -> None:
 def walked(scene) -> tuple:
     """(a mesh of the scene or None, whether the scene's BVH holds only spheres): what tracing it
     would hand to compiled walks, if it had them (Scene.walks)."""
-    mesh = next((o.shape for o in scene.objects if isinstance(o.shape, Mesh)), None)
+    mesh = next((o.shape for _, o in singles(scene.objects) if isinstance(o.shape, Mesh)), None)
     return mesh, scene.accel is not None and scene.accel.all_spheres

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
+from rtcli.core.objects import object_materials, singles, sphere_blocks
 from rtcli.core.scene import object_tree
 from rtcli.core.vec import unit
 from rtcli.shapes.sphere import Sphere
@@ -36,10 +37,16 @@ class Accelerator:
         objects, bounded = scene.objects, scene.boxes.bounded
         self.unbounded = np.flatnonzero(~bounded)
         self.members, self.bvh = object_tree(scene, levels)
-        self.is_sphere = np.array([type(o.shape) is Sphere and o.transform is None for o in objects],
-                                  dtype=bool) & bounded                              # by object index
-        self.spheres = np.array([o.shape.row if s else np.zeros(5) for o, s in zip(objects, self.is_sphere)]).T
-        self.material = np.array([o.material for o in objects], dtype=np.int64)
+        n = len(objects)
+        self.is_sphere, self.spheres = np.zeros(n, dtype=bool), np.zeros((5, n))     # by object index
+        for k, o in singles(objects):
+            self.is_sphere[k] = type(o.shape) is Sphere and o.transform is None and bounded[k]
+            if self.is_sphere[k]:
+                self.spheres[:, k] = o.shape.row
+        for start, block in sphere_blocks(objects):              # spheres kept as arrays (core/objects.py)
+            end = start + len(block)
+            self.is_sphere[start:end], self.spheres[:, start:end] = True, block.rows.T
+        self.material = object_materials(objects)
         self.shadow = scene.materials.shadow[self.material]
         self.all_spheres = bool(self.is_sphere[self.members].all())    # the compiled walk can do it all
 

@@ -18,8 +18,10 @@ from rtcli.core.dielectric import FEELER_CROSSINGS
 from rtcli.core.scene import Scene
 from rtcli.core.shading import facing
 from rtcli.core.textures import IMAGE, KIND, texture_color
-from rtcli.core.transform import normal_to_world, ray_to_object
+from rtcli.core.transform import WORLD, linear, normal_to_world, ray_to_object
 from rtcli.core.vec import unit
+from rtcli.shapes.mesh import Mesh
+from rtcli.shapes.triangle import SMOOTH, Triangle, terminator
 from rtcli.wavefront.rays import Rays
 
 
@@ -42,6 +44,7 @@ class Surface:
     obj: np.ndarray         # (n,) index into scene.objects (which solid a refracted ray enters or leaves)
     material: np.ndarray    # (n,) row of the MaterialTable
     texture: np.ndarray     # (3, n) texture color T (1 without a texture)
+    lift: np.ndarray | None = None  # (3, n) where feelers leave from, less p (render: {shadow_terminator: offset})
 
 
 def to_object(obj, o, d):
@@ -203,7 +206,25 @@ def surface(scene: Scene, rays: Rays, hits: Hits) -> Surface:
         _object_surface(scene, scene.objects[k], rays, hits, rows, normal, geometric, material, texture)
     with np.errstate(invalid="ignore"):
         nx, ny, nz, gx, gy, gz, entering = facing(*rays.d, *normal, *geometric)
-    return Surface(p, np.array([nx, ny, nz]), np.array([gx, gy, gz]), entering, hits.obj, material, texture)
+    return Surface(p, np.array([nx, ny, nz]), np.array([gx, gy, gz]), entering, hits.obj, material, texture,
+                   lifts(scene, rays, hits) if scene.settings.shadow_terminator == "offset" else None)
+
+
+def lifts(scene: Scene, rays: Rays, hits: Hits) -> np.ndarray:
+    """(3, n) each hit's shadow-terminator shift (the triangle's `terminator` kernel, taken to world
+    space as a vector): nonzero on smooth triangles and meshes only (docs/scene-format.md)."""
+    out = np.zeros((3, len(rays)))
+    for k in np.unique(hits.obj):
+        obj = scene.objects[k]
+        if not isinstance(obj.shape, (Triangle, Mesh)) or obj.shape.row[SMOOTH] == 0:
+            continue
+        rows = np.flatnonzero(hits.obj == k)
+        o_obj, d_obj = to_object(obj, rays.o[:, rows], rays.d[:, rows])
+        shift = terminator(obj.shape.row, obj.shape.pool, hits.prim[rows], *(o_obj + hits.t[rows] * d_obj))
+        if obj.transform is not None:
+            shift = linear(obj.transform, WORLD, *shift)
+        out[:, rows] = np.broadcast_arrays(*shift, rows)[:3]
+    return out
 
 
 def _object_surface(scene, obj, rays, hits, rows, normal, geometric, material, texture) -> None:
@@ -217,7 +238,8 @@ def _object_surface(scene, obj, rays, hits, rows, normal, geometric, material, t
         ns, ng = normal_to_world(obj.transform, 0, *ns), normal_to_world(obj.transform, 0, *ng)
     with np.errstate(invalid="ignore", divide="ignore"):
         normal[:, rows], geometric[:, rows], material[rows] = unit(*ns), unit(*ng), mat
-    fill_texture(scene, p_obj, lambda sel: obj.shape.uv_at(p_obj[:, sel], prim[sel]), mat, texture, rows)
+    fill_texture(scene, obj.shape.texture_points(p_obj, prim), lambda sel: obj.shape.uv_at(p_obj[:, sel], prim[sel]),
+                 mat, texture, rows)
 
 
 def uv_at_hits(scene: Scene, rays: Rays, hits: Hits) -> np.ndarray:

@@ -32,7 +32,8 @@ def local(scene: Scene, rays: Rays, s: Surface, stats: Stats, log=None) -> np.nd
     V = -np.array(unit(*rays.d))
     NV = dot(*N, *V)
     shiny = table.shiny[m]                               # spec is only worked out where ks > 0
-    start = s.p + scene.offset * s.ng                    # feelers leave from the lit side
+    base = s.p if s.lift is None else s.p + s.lift       # shadow_terminator: offset moves them (Hanika)
+    start = base + scene.offset * s.ng                   # feelers leave from the lit side
     blinn = scene.settings.specular == "blinn"
     for index, (light, row) in enumerate(zip(scene.lights, scene.light_rows)):
         I = row[COLOR:COLOR + 3]

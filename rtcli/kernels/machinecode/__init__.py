@@ -10,7 +10,7 @@ cache (position-independent object code from numba's optimised module, linked by
 compiler, `cc`), and `load` opens it with ctypes: no numba, no LLVM, about a millisecond.
 It is the same code numba runs: the entry is wrapped in a C function (numba's cfunc) that
 rebuilds the arguments from a flat list of words, so the pixels are the same bit for bit
-(tests/test_machinecode.py).
+(tests/kernels/test_machinecode.py).
 
 The arguments of an entry are arrays, numbers, bools and namedtuples of those (the
 compiled engine's Geometry and Looks). Their `layout` (each leaf's kind, an array's dtype
