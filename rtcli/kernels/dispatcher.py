@@ -15,8 +15,10 @@ and numba generates the code as usual.
 
 from __future__ import annotations
 
+import llvmlite.binding as ll
 from numba.core import errors
 from numba.core import types as nt
+from numba.core.codegen import JITCodeLibrary
 from numba.core.registry import CPUDispatcher
 
 
@@ -41,8 +43,6 @@ def _callee_machine_code(finalize):
     module itself. No Python calls a callee (it has no wrapper), and every caller inlines or compiles
     what it calls in its own library, so that machine code was made for nothing: 7.2 s of LLVM's
     time in a cold compile of the render engine, 3.0 s without it."""
-    import llvmlite.binding as ll  # numba's
-
     outside = (ll.Linkage.external, ll.Linkage.linkonce_odr)
 
     def finalize_callee(self):
@@ -76,7 +76,6 @@ def _callee_optimisation(optimise):
 
 
 def _install() -> None:
-    from numba.core.codegen import JITCodeLibrary
     for name, change in (("_finalize_final_module", _callee_machine_code),
                          ("_optimize_final_module", _callee_optimisation)):
         original = getattr(JITCodeLibrary, name, None)
