@@ -42,6 +42,7 @@ bench: warmup
 	$(PY) bench/run.py
 	$(PY) bench/run.py --scenes million,torus1m
 	$(PY) bench/rays.py
+	$(PY) bench/compile.py --runs 1
 
 clean:
 	rm -rf $(VENV) *.egg-info whitted.png

@@ -19,6 +19,7 @@ numba's own count of cache misses (Dispatcher.stats), which decides what is repo
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -62,12 +63,79 @@ def _misses(dispatchers) -> int:
         return 0
 
 
+def functions(entries: list) -> dict:
+    """The numba functions `entries` are made of, by id: themselves and every compiled function they
+    call, found through the names their code reads (a compiled variant's globals are its callees)."""
+    found, todo = {}, list(entries)
+    while todo:
+        d = todo.pop()
+        if id(d) in found or not hasattr(d, "py_func"):
+            continue
+        found[id(d)] = d
+        scope = getattr(d.py_func, "__globals__", {})
+        todo.extend(scope.get(name) for name in getattr(d.py_func, "__code__", None).co_names if name in scope)
+    return found
+
+
+class Progress:
+    """While numba compiles `entries`, says every `period` seconds how many of the functions they are
+    made of it has compiled (or loaded from the cache) and for how long it has been at it, from numba's
+    compile events: a minute is never silent."""
+
+    PERIOD = 5.0
+
+    def __init__(self, entries: list, what: str, notes: Callable[[str], None], period: float | None = None):
+        self.what, self.notes, self.period = what, notes, self.PERIOD if period is None else period
+        self.todo = functions(entries)
+        self.done = {i for i, d in self.todo.items() if getattr(d, "signatures", None)}   # in memory already
+        self.stop, self.began = threading.Event(), time.perf_counter()
+
+    def __enter__(self):
+        from numba.core import event  # start-up: numba is loaded already when something compiles
+        self.listener = _listener(self.todo, self.done)
+        event.register("numba:compile", self.listener)
+        self.thread = threading.Thread(target=self._tell, daemon=True, name="rtcli compile progress")
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        from numba.core import event  # start-up: as above
+        self.stop.set()
+        self.thread.join()
+        event.unregister("numba:compile", self.listener)
+
+    def line(self) -> str:
+        return (f"compiling {self.what}: {len(self.done)} of {len(self.todo)} functions, "
+                f"{time.perf_counter() - self.began:.0f} s")
+
+    def _tell(self) -> None:
+        while not self.stop.wait(self.period):
+            self.notes(self.line())
+
+
+def _listener(todo: set, done: set):
+    """A numba event listener adding to `done` each function of `todo` whose compile (or load) ended."""
+    from numba.core.event import Listener  # start-up: as above
+
+    class Heard(Listener):
+        def on_start(self, event):
+            pass
+
+        def on_end(self, event):
+            d = (event.data or {}).get("dispatcher")
+            if id(d) in todo:
+                done.add(id(d))
+    return Heard()
+
+
 def ready(entries: list, call: Callable[[], object], what: str, about: str,
-          notes: Callable[[str], None] | None = None, start: float | None = None) -> Load:
+          notes: Callable[[str], None] | None = None, start: float | None = None,
+          period: float | None = None) -> Load:
     """Run `call`, which calls the compiled functions `entries` a first time, so that their machine
     code is loaded from the cache or compiled. When that compiles, say so on `notes` (default:
     stderr) before, with `what` is compiled, `about` how long it takes and where it is cached, and
-    how long it took after. The Load's seconds count from `start` (default: now)."""
+    every `period` seconds (Progress.PERIOD) how far it has got while it compiles, and how long it took
+after. The Load's seconds count from `start` (default: now)."""
     notes = notes or say
     start = time.perf_counter() if start is None else start
     todo = [d for d in entries if not d.signatures]          # in memory already: nothing to load
@@ -77,7 +145,11 @@ def ready(entries: list, call: Callable[[], object], what: str, about: str,
         notes(f"compiling {what}, once ({about}); " + (f"cached in {where}" if where.enabled else
                                                          f"not cached: {where.why} (see RTCLI_CACHE_DIR)"))
     misses, began = _misses(todo), time.perf_counter()
-    call()
+    if cold:
+        with Progress(todo, what, notes, period):
+            call()
+    else:
+        call()
     spent = time.perf_counter() - began
     compiled = _misses(todo) > misses
     if compiled:

@@ -33,15 +33,17 @@ and differ from the C library's in the last bit. rtcli's own elementary function
 kernels themselves, are in rtcli/core/elementary.py, and `foreign_math` finds any
 other (a test checks every kernel).
 
-Compiled-variant options (measured on the bench scenes; docs/architecture.md):
-error_model="numpy" (x / 0 is inf or nan, as in numpy, instead of raising), no
+Compiled-variant options (measured; docs/architecture.md, "How the compiled variants are
+built"): error_model="numpy" (x / 0 is inf or nan, as in numpy, instead of raising), no
 reference counting (`_nrt=False`: kernels only read arrays the caller owns; counting
-references to each array argument on every call made renders 2.3x slower), and
-`inline=True` (numba inlines the function into its callers) for the ops and for the
-functions that take the engine's tuples of arrays (the scene's geometry, the
-materials): passing a tuple of arrays costs several machine words per array and call.
-Math kernels are left to LLVM, which inlines the small ones itself; inlining them in
-numba too only doubled the first compile (80 s instead of 36 s) for no speed.
+references to each array argument on every call made renders 2.3x slower). The ops and the
+functions marked `inline=True` (those that take the engine's tuples of arrays: passing a
+tuple of arrays costs several machine words per array and call) are inlined by LLVM into
+their callers (numba's `forceinline`, LLVM's alwaysinline), not by numba (its
+inline="always" types the callee again at every call site: the integrator's first compile
+took twice as long). A kernel called by other kernels is compiled once as a callee, without
+the wrappers that let Python call it; and once per type of its arguments, not per constant
+(rtcli/kernels/dispatcher.py): the scene's hit dispatch was compiled six times over.
 """
 
 from __future__ import annotations
@@ -122,10 +124,16 @@ def compiled(f, **bind):
     return _variant(f, "compiled", bind)
 
 
-def _variant(f, variant: str, bind: dict):
+_origins: dict = {}                      # id of a compiled variant -> (kernel, bind): for its callee twin
+
+
+def _variant(f, variant: str, bind: dict, callee: bool = False):
+    """The variant of f; `callee`: the compiled one as other kernels call it, without the code that
+    lets Python call it (numba's wrappers), which would be compiled for nothing."""
     if not is_kernel(f):
         raise TypeError(f"{f.__qualname__} is not a kernel")
-    key = (f, variant, tuple(sorted((k, id(v)) for k, v in bind.items())))
+    callee = callee and variant == "compiled"
+    key = (f, variant, tuple(sorted((k, id(v)) for k, v in bind.items())), callee)
     if key in _made:
         return _made[key]
     if variant not in _ops:
@@ -133,21 +141,35 @@ def _variant(f, variant: str, bind: dict):
     scope = dict(f.__globals__)
     scope.update(_ops[variant])
     made = types.FunctionType(f.__code__, scope, f.__name__, f.__defaults__, f.__closure__)
-    made.__qualname__ = f.__qualname__ + _suffix(bind)
+    made.__qualname__ = f.__qualname__ + _suffix(bind) + (".callee" if callee else "")
     made.__module__, made.__doc__ = f.__module__, f.__doc__
     if variant == "compiled":
-        made = _numba(made, f.__kernel__)
+        made = _numba(made, f.__kernel__, callee)
+        _origins[id(made)] = (f, bind)
     _made[key] = made                    # before the callees: a kernel may call itself through bind
     for name in f.__code__.co_names:
         value = bind[name] if name in bind else f.__globals__.get(name)
         if name in bind and not is_kernel(value):
-            scope[name] = value
+            scope[name] = _callee_of(value, variant)
         elif is_kernel(value):
-            scope[name] = _variant(value, variant, {})
+            scope[name] = _variant(value, variant, {}, callee=True)
         elif isinstance(value, types.ModuleType) and value not in (np, math):
             raise TypeError(f"kernel {f.__qualname__} calls through module {value.__name__}: "
                             "import the kernels it calls by name")
     return made
+
+
+def _callee_of(value, variant: str):
+    """A bound value as a kernel calls it: a compiled variant's callee twin, else the value."""
+    if variant == "compiled" and id(value) in _origins and value is _made.get(_key_of(value)):
+        f, bind = _origins[id(value)]
+        return _variant(f, variant, bind, callee=True)
+    return value
+
+
+def _key_of(value):
+    f, bind = _origins[id(value)]
+    return (f, "compiled", tuple(sorted((k, id(v)) for k, v in bind.items())), False)
 
 
 def _suffix(bind: dict) -> str:
@@ -159,17 +181,20 @@ def _suffix(bind: dict) -> str:
     return "_" + hashlib.sha1(what.encode()).hexdigest()[:12]
 
 
-def _numba(f, how: Kernel):
+def _numba(f, how: Kernel, callee: bool = False):
     _start_numba()
-    from numba import njit  # numba, optional (the fast extra): only when compiling
+    from rtcli.kernels.dispatcher import Dispatcher  # numba, optional (the fast extra): only when compiling
     where = cache_location()
-    options = dict(cache=where.enabled, error_model="numpy")
+    options = dict(nopython=True, error_model="numpy", forceinline=how.inline)
     if not how.entry:
         options["_nrt"] = False
-    if how.inline:
-        options["inline"] = "always"
+    if callee:
+        options.update(no_cpython_wrapper=True, no_cfunc_wrapper=True)
     with where.applied():
-        return njit(**options)(f)
+        made = Dispatcher(py_func=f, locals={}, targetoptions=options)
+        if where.enabled:
+            made.enable_caching()
+    return made
 
 
 _started = False
@@ -228,5 +253,5 @@ _ALLOWED = [getattr(vocabulary, name) for name in VOCABULARY]
 
 def variants_made() -> list:
     """(qualname, variant) of every variant made so far (for tests and the cache guard)."""
-    return [(f.__qualname__, v) for (f, v, _) in _made]
+    return [(f.__qualname__, v) for (f, v, _, _) in _made]
 

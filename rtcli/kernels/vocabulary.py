@@ -188,7 +188,7 @@ def numba_ops() -> dict:
                 x, n = x * _TWO_M969, max(n + 969, -1022)
         return x * bits_float(np.uint64(n + 1023) << np.uint64(52))
 
-    small = njit(inline="always", error_model="numpy", _nrt=False)
+    small = njit(forceinline=True, no_cpython_wrapper=True, no_cfunc_wrapper=True, error_model="numpy", _nrt=False)
     ops = {name: small(f) for name, f in SCALAR.items() if f.__module__ == __name__ and name not in _EXACT_LIBM}
     ops.update(sqrt=math.sqrt, floor=np.floor, frexp=small(frexp), ldexp=small(ldexp), copysign=math.copysign,
                isfinite=math.isfinite, isnan=math.isnan, bits=float_bits)

@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -72,9 +74,11 @@ def test_the_compile_note_appears_exactly_when_compiling(warm, tmp_path):
     code, out, err = rtcli("warmup", env=env)
     assert code == 0, err
     assert f"cache: {cache} ({numba_cache.CACHE_ENV})" in out
-    assert err.splitlines()[0] == f"note: compiling the numpy engine's BVH walks, once (about half a minute); " \
-                                  f"cached in {cache}"
-    assert err.splitlines()[1].startswith("note: compiled in ") and len(err.splitlines()) == 2
+    lines = err.splitlines()
+    assert lines[0] == f"note: compiling the numpy engine's BVH walks, once (about half a minute); cached in {cache}"
+    assert lines[-1].startswith("note: compiled in ")
+    assert all(re.fullmatch(r"note: compiling the numpy engine's BVH walks: \d+ of \d+ functions, \d+ s", line)
+               for line in lines[1:-1])                           # every few seconds, how far it has got
     assert "the render engine (compiled): loaded from the cache" in out
     assert "the numpy engine's BVH walks: compiled in" in out and out.rstrip().endswith("in all")
     assert list(cache.glob(f"*/{WALKS}"))                        # cached where it said
@@ -243,6 +247,35 @@ def test_a_forecast_of_numbas_cache(tmp_path, monkeypatch):
     assert load.compile_seconds == 0 and len(heard) == 2
     assert loading.ready([g], lambda: g(2.0), "twice", "a moment", heard.append).compile_seconds == 0
     assert len(heard) == 2                                            # in memory already: not even looked up
+
+
+def test_a_long_compile_says_how_far_it_has_got(tmp_path, monkeypatch):
+    """While numba compiles, a line every `period` seconds: how many of the functions the entries are
+    made of are compiled, and for how long it has been compiling."""
+    (tmp_path / "thrice_mod.py").write_text(textwrap.dedent("""
+        from numba import njit
+
+        @njit(cache=True)
+        def one(x):
+            return x + 1.0
+
+        @njit(cache=True)
+        def thrice(x):
+            return 3 * one(x)
+    """))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import thrice_mod
+    assert set(loading.functions([thrice_mod.thrice])) == {id(thrice_mod.thrice), id(thrice_mod.one)}
+    heard = []
+
+    def slowly():
+        thrice_mod.thrice(1.0)
+        time.sleep(0.5)
+    load = loading.ready([thrice_mod.thrice], slowly, "thrice", "a moment", heard.append, period=0.1)
+    assert load.compile_seconds > 0.5 and heard[0].startswith("compiling thrice, once (a moment)")
+    assert heard[-1].startswith("compiled in ") and len(heard) >= 5
+    assert all(re.fullmatch(r"compiling thrice: \d of 2 functions, \d+ s", line) for line in heard[1:-1])
+    assert re.fullmatch(r"compiling thrice: 2 of 2 functions, \d+ s", heard[-2])     # during the sleep: all done
 
 
 def test_after_warmup_no_scene_compiles_anything(warm, monkeypatch):
