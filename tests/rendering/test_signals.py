@@ -138,17 +138,8 @@ def test_ctrl_c_while_tiles_are_submitted_waits_until_every_tile_is(monkeypatch)
     assert len(submitted) == 16
 
 
-HEAVY = """\
-image: {width: 1600, height: 1600}
-camera: {eye: [0, 2, 8], look_at: [0, 0, 0], fov: 50}
-render: {samples: 8, max_depth: 8}
-lights: [{position: [5, 8, 5], area: {u: [1, 0, 0], v: [0, 0, 1], samples: 4}}]
-objects:
-  - {plane: {}, material: {reflection: 0.5}}
-  - {sphere: {center: [-1.5, 1, 0]}, material: {reflection: 0.8}}
-  - {sphere: {center: [1.5, 1, 0]}, material: {transmission: 0.9, ior: 1.5}}
-  - {torus: {major: 1, minor: 0.3}, transform: [{translate: [0, 1, -2]}]}
-"""                                      # one tile of minutes with --engine compiled
+HEAVY = (SLOW.replace("width: 320, height: 240", "width: 1600, height: 1600")   # one tile of minutes
+         .replace("max_depth: 6", "max_depth: 8"))                             # with --engine compiled
 
 
 @pytest.mark.skipif(not variants.ENABLED, reason="numba is not installed")

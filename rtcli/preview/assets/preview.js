@@ -327,12 +327,28 @@
 
   function rayNode(node, p, open) {
     const h = node.hit;
-    const title = h ? [`${node.kind} ray: hits #${h.object} ${h.name || "(unnamed)"} (${h.shape}) = `, vec(node.total)]
+    const title = node.more ? [`${node.kind} ray and ${node.more - 1} below it, past the node budget: adds `, vec(node.contribution)]
+      : h ? [`${node.kind} ray: hits #${h.object} ${h.name || "(unnamed)"} (${h.shape}) = `, vec(node.total)]
       : [`${node.kind} ray: misses, the background `, vec(node.value)];
-    const d = el("details", { class: h ? "ray" : "ray miss", open }, el("summary", {}, ...title));
+    const d = el("details", { class: h || node.more ? "ray" : "ray miss", open }, el("summary", {}, ...title));
     d.append(row(val(`${p}.kind`, node.kind), " ray, depth ", val(`${p}.depth`, node.depth), ": from ",
-      val(`${p}.origin`, node.origin), " along ", val(`${p}.direction`, node.direction)));
+      val(`${p}.origin`, node.origin), " along ", val(`${p}.direction`, node.direction),
+      node.more ? null : el("span", { class: "note" }, "  (none of its rays summarised: "),
+      node.more ? null : val(`${p}.more`, node.more), node.more ? null : el("span", { class: "note" }, ")")));
     if (node.weight) d.append(row("its weight in its parent's color: ", val(`${p}.weight`, node.weight)));
+    if (node.more) {
+      d.append(row(el("span", { class: "note" }, "… "), val(`${p}.more`, node.more),
+        el("span", { class: "note" }, " more rays (this one and those below it, past the node budget: --max-nodes), total contribution "),
+        val(`${p}.contribution`, node.contribution), el("span", { class: "label" }, "  (its color "), val(`${p}.value`, node.value),
+        el("span", { class: "label" }, ")")));
+      return d;
+    }
+    node.bailouts.forEach((cut, i) => {
+      const q = `${p}.bailouts.${i}`;
+      d.append(row(el("span", { class: "note" }, `${cut.kind} ray not traced: its weight `), val(`${q}.weight`, cut.weight),
+        el("span", { class: "note" }, ", its path weight "), val(`${q}.path`, cut.path),
+        el("span", { class: "note" }, " is below adc_bailout "), val(`${q}.adc_bailout`, cut.adc_bailout)));
+    });
     if (!h) {
       d.append(row("misses every object: the background ", val(`${p}.value`, node.value)));
       return d;
