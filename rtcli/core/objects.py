@@ -1,7 +1,7 @@
 """A scene's objects: one by one, and blocks of plain spheres kept as arrays.
 
 A particle cloud of a million spheres would cost a SceneObject and a Sphere each
-(seconds to make, a gigabyte to keep). A `SphereBlock` keeps such a run of spheres
+(seconds to make, a gigabyte to keep). A `SphereBlock` (shapes/sphere_block.py) keeps such a run of spheres
 (no transform, no name) as arrays: their rows as the sphere kernels read them
 (center, r, r^2), their materials and where each is written. `ObjectList` is the
 scene's sequence of objects: indexing or iterating it gives SceneObjects as before,
@@ -19,8 +19,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rtcli.core.transform import Transform, outer_bounds
-from rtcli.errors import Where
-from rtcli.shapes.sphere import Sphere
 
 
 @dataclass(slots=True)
@@ -42,44 +40,6 @@ class SceneObject:
         return outer_bounds(self.world_from_object, self.shape.bounds())
 
 
-class SphereBlock:
-    """n plain spheres: `rows` (n, 5) center, r, r^2; `material` (n,) rows of the MaterialTable;
-    where each is written, for messages: `file`, `lines` (n,) and `column` (0: no place, an array's
-    spheres), and `path` with `first`: sphere j is `path[first + j]`."""
-
-    __slots__ = ("rows", "material", "file", "lines", "column", "path", "first")
-
-    def __init__(self, centers, radii, material, file: str = "", lines=None, column: int = 0,
-                 path: str = "spheres", first: int = 0):
-        centers, radii = np.asarray(centers, dtype=float), np.asarray(radii, dtype=float)
-        self.rows = np.empty((len(radii), 5))
-        self.rows[:, :3], self.rows[:, 3], self.rows[:, 4] = centers, radii, radii * radii
-        self.material = np.broadcast_to(np.asarray(material, dtype=np.int64), (len(radii),))
-        self.file, self.column, self.path, self.first = file, column, path, first
-        self.lines = lines
-
-    def __len__(self) -> int:
-        return len(self.rows)
-
-    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(lo, hi) each (n, 3): the spheres' boxes, as Sphere.bounds gives them one by one."""
-        c, r = self.rows[:, :3], self.rows[:, 3:4]
-        return c - r, c + r
-
-    def where(self, j: int) -> str:
-        """'file:line:col: path[k]' of sphere j, as a SceneObject's `where`."""
-        label = f"{self.path}[{self.first + j}]"
-        if self.lines is None:
-            return f"{self.file}: {label}" if self.file else label
-        return f"{Where(self.file, int(self.lines[j]), self.column)}: {label}"
-
-    def object(self, j: int, id: int) -> SceneObject:
-        """Sphere j as a SceneObject with id `id` (made now: kept nowhere)."""
-        shape = Sphere.__new__(Sphere)
-        shape.row = self.rows[j].copy()
-        return SceneObject(id, "", shape, int(self.material[j]), None, "sphere", self.where(j))
-
-
 class ObjectList(Sequence):
     """The scene's objects in id order: SceneObjects one by one, and SphereBlocks."""
 
@@ -97,8 +57,8 @@ class ObjectList(Sequence):
         self._parts[-1].append(o)
         self._n += 1
 
-    def add_block(self, block: SphereBlock) -> None:
-        """Append the block's spheres (ids from len(self) + 1 on)."""
+    def add_block(self, block) -> None:
+        """Append the block's spheres (ids from len(self) + 1 on): a SphereBlock (shapes/sphere_block.py)."""
         if len(block):
             self._starts.append(self._n)
             self._parts.append(block)
@@ -137,7 +97,7 @@ def _rebuilt(starts, parts, n) -> ObjectList:
     return objects
 
 
-def sphere_blocks(objects) -> list[tuple[int, SphereBlock]]:
+def sphere_blocks(objects) -> list[tuple[int, object]]:
     """(index of its first sphere, block) of each SphereBlock of a scene's objects."""
     if type(objects) is not ObjectList:
         return []
@@ -183,7 +143,7 @@ def kind_counts(objects) -> dict[str, int]:
     """How many objects of each kind (the YAML shape name), in order of first appearance."""
     counts: dict[str, int] = {}
     for start, part in zip(objects._starts, objects._parts) if type(objects) is ObjectList else [(0, objects)]:
-        if type(part) is SphereBlock:
+        if type(part) is not list:                       # a SphereBlock
             counts["sphere"] = counts.get("sphere", 0) + len(part)
             continue
         for o in part:

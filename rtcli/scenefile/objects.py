@@ -14,10 +14,11 @@ import os
 import numpy as np
 
 from rtcli.core import transform as tf
-from rtcli.core.objects import ObjectList, SceneObject, SphereBlock
+from rtcli.core.objects import ObjectList, SceneObject
 from rtcli.errors import SceneError, Where, shown
 from rtcli.scenefile import params as required
 from rtcli.scenefile import reuse
+from rtcli.scenefile.arrays import MeshArrays, SphereArrays
 from rtcli.scenefile.guards import bounded, check_count
 from rtcli.scenefile.limits import MAX_MAGNITUDE, MAX_OBJECTS
 from rtcli.scenefile.materials import material_ref
@@ -25,13 +26,13 @@ from rtcli.scenefile.named_files import read_mesh_file
 from rtcli.scenefile.nodes import MapNode
 from rtcli.scenefile.params import Params, as_params
 from rtcli.scenefile.transforms import compose, transform_from
-from rtcli.scenefile.arrays import MeshArrays, SphereArrays
 from rtcli.scenefile.yamlbulk import SphereRun
 from rtcli.scenefile.yamlevents import Builder, Loader
 from rtcli.shapes import SHAPES
 from rtcli.shapes.base import REQUIRED, ParamError
-from rtcli.shapes.mesh import Mesh
 from rtcli.shapes.csg import CSG, OPS, Child
+from rtcli.shapes.mesh import Mesh
+from rtcli.shapes.sphere_block import SphereBlock
 
 OBJECT_KINDS = tuple(SHAPES) + ("csg", "group")
 
