@@ -111,16 +111,18 @@ class Processes:
     def start(self, line: str, cwd, env) -> subprocess.Popen:
         process = subprocess.Popen(line, shell=True, cwd=cwd, env=env, start_new_session=True,
                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        self.started.append(process.pid)
+        self.started.append(process)
         return process
 
     def stop(self):
-        for pid in reversed(self.started):
-            kill_group(pid)
+        for process in reversed(self.started):
+            kill_group(process.pid, process)
 
 
-def kill_group(pid: int) -> None:
-    """SIGTERM to the process group, then SIGKILL to what is left of it after 10 s."""
+def kill_group(pid: int, leader: subprocess.Popen | None = None) -> None:
+    """SIGTERM to the process group, then SIGKILL to what is left of it after 10 s. `leader`, the
+    group's first process when it is this process's child, is reaped as it ends (a zombie would
+    keep the group alive to the end of the wait)."""
     for sig in (signal.SIGTERM, signal.SIGKILL):
         try:
             os.killpg(pid, sig)
@@ -128,6 +130,8 @@ def kill_group(pid: int) -> None:
             return
         end = time.monotonic() + 10
         while time.monotonic() < end:
+            if leader is not None:
+                leader.poll()
             try:
                 os.killpg(pid, 0)
             except ProcessLookupError:

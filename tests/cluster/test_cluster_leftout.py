@@ -71,7 +71,7 @@ def joining(tmp_path):
     for process in started:
         process.terminate()
         try:
-            process.wait(20)
+            process.wait(3)                # a worker whose scheduler has gone waits for it: not worth it
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait(20)

@@ -38,7 +38,7 @@ class Server(asyncssh.SSHServer):
 
     def connection_lost(self, exc) -> None:
         for child in self.children:
-            kill_group(child.pid)
+            kill_group(child.pid, child)
 
 
 class SSH:
@@ -75,7 +75,7 @@ class SSH:
         self.loop.call_soon_threadsafe(self.loop.stop)
         self.thread.join(30)
         for child in self.children:
-            kill_group(child.pid)
+            kill_group(child.pid, child)
 
 
 def test_the_ssh_cluster_script_runs_against_an_ssh_server_here(here, tmp_path):
