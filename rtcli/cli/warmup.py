@@ -15,7 +15,7 @@ from rtcli.cli.terminal import note
 @click.command()
 @cluster_options("Warm every worker of", " This machine is not warmed.")
 def warmup(cluster, cluster_file, local_cluster, cluster_timeout):
-    """Compile the render engine now (about a minute, once), or load it from numba's cache; say
+    """Compile the render engine now (about half a minute, once), or load it from numba's cache; say
     where the cache is and how long it took. Renders then start at once. With a cluster option:
     on every worker of the cluster at once, a line for each."""
     where = reach(cluster, cluster_file, local_cluster, note, cluster_timeout)

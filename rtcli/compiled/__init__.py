@@ -64,8 +64,8 @@ class Compiled:
         self.entry, why = None, _import_integrator()
         if why:
             raise RtcliError(why)
-        self.load = ready([compiled_integrator()], lambda: compiled_integrator()(*args), "the render engine", "about a minute",
-                          notes, start)     # no ray: just the machine code
+        self.load = ready([compiled_integrator()], lambda: compiled_integrator()(*args), "the render engine",
+                          "about half a minute", notes, start)     # no ray: just the machine code
         if self.load.compile_seconds:                   # so that later processes start without numba
             began = time.perf_counter()
             why = machinecode.make(ENTRY, compiled_integrator(), args)

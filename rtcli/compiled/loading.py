@@ -2,7 +2,7 @@
 
 numba compiles a function the first time it is called, then keeps the machine code on disk
 (numba_cache.cache_location() says where): a later process loads it in a fraction of a second,
-but the first one spends about a minute compiling the integrator. That minute is never
+but the first one spends about half a minute compiling the integrator. That time is never
 silent: `ready` says on stderr that it compiles, where the code will be cached and, after,
 how long it took; and it returns the time apart (RenderStats.load_seconds, compile_seconds),
 so that no render counts it as tracing.

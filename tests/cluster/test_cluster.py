@@ -313,7 +313,7 @@ def test_several_scenes_on_the_cluster_are_the_local_renders_all_placed_or_none(
 
 
 # --- the engine's start-up on the workers ---
-COMPILING = "compiling the render engine, once (about a minute); cached in /somewhere"
+COMPILING = "compiling the render engine, once (about half a minute); cached in /somewhere"
 
 
 @pytest.fixture

@@ -1,7 +1,7 @@
 """The compiled code's start-up: where numba's cache lives, `rtcli warmup`, the note when rtcli
 compiles, and --stats keeping start-up apart from tracing.
 
-A whole compile of the integrator takes about a minute, so the tests that need one compile only
+A whole compile of the integrator takes about half a minute, so the tests that need one compile only
 a part: the warm cache beside the sources (made by `rtcli warmup`, which `make test` runs first,
 or by the fixture below) is copied into a folder of its own without the index files of the
 functions meant to compile; numba then compiles those alone, loading what they call.
@@ -93,7 +93,7 @@ def test_a_render_that_compiles_says_so_and_keeps_it_out_of_the_render_time(warm
             "--engine", "compiled", "--workers", "1", "--stats", "--json")
     code, out, err = rtcli(*args, env=env)
     assert code == 0, err
-    assert err.splitlines()[0] == f"note: compiling the render engine, once (about a minute); cached in {cache}"
+    assert err.splitlines()[0] == f"note: compiling the render engine, once (about half a minute); cached in {cache}"
     stats = json.loads(out)
     assert stats["compile_seconds"] > 0 and stats["load_seconds"] >= stats["compile_seconds"]
     assert stats["wall_seconds"] >= stats["seconds"] + stats["load_seconds"]
@@ -155,7 +155,7 @@ def test_numba_writes_to_the_per_user_cache_when_the_sources_are_read_only(warm,
                           env={**env, "XDG_CACHE_HOME": str(user), "HOME": str(tmp_path), "RTCLI_MACHINE_CODE": "0"})
     assert done.returncode == 0, done.stderr
     assert f"cache: {cache} (the per-user cache: rtcli's folder is read-only)" in done.stdout
-    assert done.stderr.startswith(f"note: compiling the render engine, once (about a minute); cached in {cache}")
+    assert done.stderr.startswith(f"note: compiling the render engine, once (about half a minute); cached in {cache}")
     assert list(cache.glob(f"*/{TRACE_CAMERA}"))
 
 
