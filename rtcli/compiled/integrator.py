@@ -31,13 +31,13 @@ from rtcli.compiled.pack import (
     NG,
     PATH_WEIGHT,
     REFRACTED_DIR,
+    SMOOTH_KINDS,
     STAGE,
     W_REFLECT,
     W_REFRACT,
     XFORM,
     D,
     N,
-    SMOOTH_KINDS,
     P,
 )
 from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, leaf_point, material_of, scene_hit
@@ -45,7 +45,7 @@ from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.camera import primary_ray
 from rtcli.core.dielectric import FEELER_CROSSINGS, fresnel, indices, refracted_media, split
 from rtcli.core.lights import COLOR, sample_point, toward, weight
-from rtcli.core.shading import ambient, diffuse, facing, specular, specular_cos
+from rtcli.core.shading import ambient, diffuse, facing, path_weight, specular, specular_cos
 from rtcli.core.textures import IMAGE, NONE, texture_color
 from rtcli.core.textures import KIND as TEXTURE_KIND
 from rtcli.core.transform import WORLD, linear, normal_to_world, ray_to_object
@@ -199,9 +199,10 @@ def shade_local(g, s, ray, f, counts, stack):
 def followed(s, f, w, child):
     """Whether the secondary ray of weights f[w:w + 3] is traced: its path weight, the frame's times
     those weights (set in the child frame), is at least adc_bailout in some channel (trace.followed)."""
-    r, g, b = f[PATH_WEIGHT] * f[w], f[PATH_WEIGHT + 1] * f[w + 1], f[PATH_WEIGHT + 2] * f[w + 2]
+    r, g, b, traced = path_weight(f[PATH_WEIGHT], f[PATH_WEIGHT + 1], f[PATH_WEIGHT + 2], f[w], f[w + 1], f[w + 2],
+                                  s.adc_bailout)
     child[PATH_WEIGHT], child[PATH_WEIGHT + 1], child[PATH_WEIGHT + 2] = r, g, b
-    return r >= s.adc_bailout or g >= s.adc_bailout or b >= s.adc_bailout
+    return traced
 
 
 @per_ray(inline=True)

@@ -59,3 +59,12 @@ def facing(dx, dy, dz, nx, ny, nz, gx, gy, gz):
     nx, ny, nz, gx, gy, gz = nx * s, ny * s, nz * s, gx * s, gy * s, gz * s
     away = dot(nx, ny, nz, dx, dy, dz) > 0
     return select(away, gx, nx), select(away, gy, ny), select(away, gz, nz), gx, gy, gz, entering
+
+
+@kernel(inline=True)
+def path_weight(pr, pg, pb, wr, wg, wb, bailout):
+    """A secondary ray's path weight, the product of the weights of the surfaces before it (its
+    parent's path weight times its own weight, per channel), and whether it is traced: at least
+    adc_bailout in some channel (docs/scene-format.md, Adaptive depth control)."""
+    r, g, b = pr * wr, pg * wg, pb * wb
+    return r, g, b, (r >= bailout) | (g >= bailout) | (b >= bailout)

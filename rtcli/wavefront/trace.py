@@ -23,6 +23,7 @@ import numpy as np
 
 from rtcli.core.dielectric import fresnel, indices, refracted_media, split
 from rtcli.core.scene import Scene
+from rtcli.core.shading import path_weight
 from rtcli.core.vec import dot, reflect, refract, unit
 from rtcli.stats import Stats
 from rtcli.wavefront.intersect import find_first_hit, surface
@@ -146,8 +147,9 @@ def followed(scene: Scene, w: np.ndarray, path: np.ndarray, kind: str, log: Log 
     """Which of the secondary rays of weights w (3, n) are traced: those with w > 0 whose path weight
     path x w is at least adc_bailout in some channel. The recorder is shown the others with w > 0."""
     spawned = w.max(axis=0) > 0
-    kept = spawned & ((path * w).max(axis=0) >= scene.settings.adc_bailout)
+    *weights, traced = path_weight(*path, *w, scene.settings.adc_bailout)
+    kept = spawned & traced
     if log and (spawned & ~kept).any():
         cut = np.flatnonzero(spawned & ~kept)
-        log.bailout(cut if rows is None else rows[cut], kind, w[:, cut], path[:, cut] * w[:, cut])
+        log.bailout(cut if rows is None else rows[cut], kind, w[:, cut], np.array(weights)[:, cut])
     return np.flatnonzero(kept)
