@@ -154,3 +154,14 @@ objects:
 def deep(depth=20, bailout="1.0e-6", reflection="1", transmission="1", fresnel="true") -> str:
     return (DEEP.replace("DEPTH", str(depth)).replace("BAILOUT", bailout).replace("REFLECTION", reflection)
             .replace("TRANSMISSION", transmission).replace("FRESNEL", fresnel))
+
+
+# a small lit scene the cluster tests render on several processes and compare with a local render
+CLUSTER_SCENE = """\
+image: {width: 24, height: 16}
+camera: {eye: [0, 1, 5], look_at: [0, 0.5, 0]}
+lights: [{position: [3, 5, 4]}]
+objects:
+  - {plane: {}, material: {diffuse: [0.6, 0.6, 0.6], reflection: 0.2}}
+  - {sphere: {center: [0, 0.5, 0], radius: 0.5}, material: {diffuse: [0.8, 0.3, 0.2], specular: 0.5}}
+"""

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 import pytest
-from helpers import same_image
+from helpers import CLUSTER_SCENE, same_image
 
 from rtcli.cli import main
 from rtcli.cluster.target import target
@@ -35,14 +35,7 @@ slow = pytest.mark.slow          # Dask schedulers and worker processes, started
 ROOT = Path(__file__).resolve().parents[2]
 PAGES = ["cluster.md", "cluster-slurm.md", "cluster-kubernetes.md"]
 BOUND = 240                      # seconds a page's commands may take here
-SCENE = """\
-image: {width: 24, height: 16}
-camera: {eye: [0, 1, 5], look_at: [0, 0.5, 0]}
-lights: [{position: [3, 5, 4]}]
-objects:
-  - {plane: {}, material: {diffuse: [0.6, 0.6, 0.6], reflection: 0.2}}
-  - {sphere: {center: [0, 0.5, 0], radius: 0.5}, material: {diffuse: [0.8, 0.3, 0.2], specular: 0.5}}
-"""
+SCENE = CLUSTER_SCENE
 
 
 def CHANGES(port: int) -> list[tuple[str, str]]:

@@ -23,7 +23,7 @@ import threading
 import time
 
 import pytest
-from helpers import same_image
+from helpers import CLUSTER_SCENE, same_image
 
 from rtcli.cluster import probe as probes
 from rtcli.cluster import renders
@@ -34,14 +34,7 @@ from rtcli.errors import RtcliError
 distributed = pytest.importorskip("distributed")
 slow = pytest.mark.slow          # an rtcli process each, or a Dask scheduler
 
-SCENE = """\
-image: {width: 24, height: 16}
-camera: {eye: [0, 1, 5], look_at: [0, 0.5, 0]}
-lights: [{position: [3, 5, 4]}]
-objects:
-  - {plane: {}, material: {diffuse: [0.6, 0.6, 0.6], reflection: 0.2}}
-  - {sphere: {center: [0, 0.5, 0], radius: 0.5}, material: {diffuse: [0.8, 0.3, 0.2], specular: 0.5}}
-"""
+SCENE = CLUSTER_SCENE
 BOUND = 90                       # seconds any command here may take before the test fails
 DEADLINE = 1.0                   # --cluster-timeout in these tests
 ADVICE = "give the address `dask scheduler` prints (tcp://HOST:8786 by default; 8787 is its dashboard)"

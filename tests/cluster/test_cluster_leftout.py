@@ -16,6 +16,7 @@ import sys
 import threading
 
 import pytest
+from helpers import CLUSTER_SCENE
 
 from rtcli.api.loading import load_file
 from rtcli.cluster import renders, software
@@ -28,14 +29,7 @@ from rtcli.rendering.tiles import Job, render
 distributed = pytest.importorskip("distributed")
 pytestmark = pytest.mark.slow   # Dask schedulers and worker processes
 
-SCENE = """\
-image: {width: 24, height: 16}
-camera: {eye: [0, 1, 5], look_at: [0, 0.5, 0]}
-lights: [{position: [3, 5, 4]}]
-objects:
-  - {plane: {}, material: {diffuse: [0.6, 0.6, 0.6], reflection: 0.2}}
-  - {sphere: {center: [0, 0.5, 0], radius: 0.5}, material: {diffuse: [0.8, 0.3, 0.2], specular: 0.5}}
-"""
+SCENE = CLUSTER_SCENE
 OTHER_SOURCES = """\
 from rtcli.cluster import software
 ours = software.fingerprint()
