@@ -33,7 +33,7 @@ import numpy as np
 
 from rtcli.compiled.build import runner
 from rtcli.compiled.loading import Load, cached, ready, say
-from rtcli.compiled.pack import frames, geometry, looks, unsupported
+from rtcli.compiled.pack import frames, geometry, lanes, looks, unsupported
 from rtcli.core.camera import Camera
 from rtcli.errors import RtcliError
 from rtcli.kernels import machinecode, numba_cache, variants
@@ -52,8 +52,8 @@ class Compiled:
     def __init__(self, scene, bvh: bool = True, notes=None, start: float | None = None):
         start = time.perf_counter() if start is None else start
         self.geometry, stack = geometry(scene, tree=bvh and scene.wants_bvh, levels=runner())
-        self.looks, self.stack = looks(scene), np.empty(stack, dtype=np.int64)
-        self.frames = frames(self.looks.max_depth)
+        self.looks, self.stack = looks(scene), np.empty(2 * stack, dtype=np.int64)   # a packet's entry: 2 words
+        self.frames, self.lanes = frames(self.looks.max_depth), lanes()
         nowhere, none = Camera(*np.zeros((4, 3))), np.zeros(0)
         self.empty_call = args = self._args(nowhere.row, none, none, 1, 1, np.zeros(4, dtype=np.int64),
                                             np.empty((0, 3)))       # no ray: the arguments' layout
@@ -79,11 +79,11 @@ class Compiled:
         thread; the packed scene is shared, and only read. The machine code file's entry lets go of
         Python's lock while it traces (ctypes), so twins trace at once (rtcli/preview/passes.py)."""
         other = copy.copy(self)
-        other.stack, other.frames = np.empty_like(self.stack), np.empty_like(self.frames)
+        other.stack, other.frames, other.lanes = (np.empty_like(a) for a in (self.stack, self.frames, self.lanes))
         return other
 
     def _args(self, cam_row, x, y, nc, nr, counts, out) -> tuple:
-        return self.geometry, self.looks, cam_row, x, y, nc, nr, counts, self.stack, out, self.frames
+        return self.geometry, self.looks, cam_row, x, y, nc, nr, counts, self.stack, out, self.frames, self.lanes
 
     def trace_pixels(self, cam, x: np.ndarray, y: np.ndarray, nc: int, nr: int, stats: Stats) -> np.ndarray:
         """Colors (n, 3) of the camera's rays through pixel coordinates (x, y)."""

@@ -21,25 +21,39 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli.compiled.pack import (
+    BEST,
     COLOR_SUM,
     CSG_KIND,
+    DX,
+    DY,
+    DZ,
     ENTERING,
     KIND,
+    LISTED,
     MATERIAL_OF,
     MEDIA_COUNT,
     MEDIA_IOR,
     NG,
+    OX,
+    OY,
+    OZ,
     PATH_WEIGHT,
+    PRIM,
     REFRACTED_DIR,
     SMOOTH_KINDS,
     STAGE,
+    T_MAX,
+    T_MIN,
     W_REFLECT,
     W_REFRACT,
+    WON,
     XFORM,
     D,
     N,
     P,
+    W,
 )
+from rtcli.compiled.packets import scene_hit_packet
 from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, leaf_point, material_of, scene_hit
 from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
 from rtcli.core.camera import primary_ray
@@ -50,7 +64,7 @@ from rtcli.core.textures import IMAGE, NONE, texture_color
 from rtcli.core.textures import KIND as TEXTURE_KIND
 from rtcli.core.transform import WORLD, linear, normal_to_world, ray_to_object
 from rtcli.core.vec import dot, reflect, refract, unit
-from rtcli.kernels.variants import per_ray
+from rtcli.kernels.variants import per_ray, to_int
 from rtcli.shapes.triangle import terminator
 
 SHADOW, REFLECTED, REFRACTED = 1, 2, 3                   # counters, as stats.Stats (primary: the caller's)
@@ -160,11 +174,11 @@ def local(g, s, m, Tr, Tg, Tb, px, py, pz, bx, by, bz, nx, ny, nz, gx, gy, gz, V
 
 
 @per_ray(inline=True)
-def shade_local(g, s, ray, f, counts, stack):
-    """First hit and local term of one ray: (hit?, color); on a hit, f is its frame (whose media
-    the caller has set), with the weights of the secondary rays."""
+def shade_local(g, s, ray, hit, f, counts, stack):
+    """The local term of one ray at its first hit (t, object, prim): (hit?, color); on a hit, f is
+    its frame (whose media the caller has set), with the weights of the secondary rays."""
     ox, oy, oz, dx, dy, dz = ray
-    t, k, prim = scene_hit(g, ox, oy, oz, dx, dy, dz, 0.0, np.inf, NEAREST, stack)
+    t, k, prim = hit
     if k < 0:
         return False, s.background[0], s.background[1], s.background[2]
     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
@@ -235,14 +249,17 @@ def next_ray(s, f, child, counts):
 
 
 @per_ray
-def radiance(g, s, ray, counts, frames, stack):
-    """The color seen along one primary ray: local + kr radiance(mirror) + kt radiance(refracted),
-    depth first with frames[L] the pending hit at depth L + 1 instead of recursion."""
+def radiance(g, s, ray, hit, counts, frames, stack):
+    """The color seen along one primary ray, whose first hit is found (a packet's): local + kr
+    radiance(mirror) + kt radiance(refracted), depth first with frames[L] the pending hit at depth
+    L + 1 instead of recursion."""
     L = 0
     frames[0, MEDIA_COUNT] = 0                                        # the camera is in the scene's medium
     frames[0, PATH_WEIGHT:PATH_WEIGHT + 3] = 1.0                      # and the primary's path weight is 1
     while True:
-        found, cr, cg, cb = shade_local(g, s, ray, frames[L], counts, stack)
+        if L > 0:
+            hit = scene_hit(g, ray[0], ray[1], ray[2], ray[3], ray[4], ray[5], 0.0, np.inf, NEAREST, stack)
+        found, cr, cg, cb = shade_local(g, s, ray, hit, frames[L], counts, stack)
         more = False
         if found and L + 1 < s.max_depth:
             more, ray = next_ray(s, frames[L], frames[L + 1], counts)
@@ -260,10 +277,20 @@ def radiance(g, s, ray, counts, frames, stack):
 
 
 @per_ray(entry=True)
-def trace_camera(g, s, cam, x, y, nc, nr, counts, stack, out, frames):
+def trace_camera(g, s, cam, x, y, nc, nr, counts, stack, out, frames, lanes):
     """The colors of the primary rays through the pixel coordinates (x, y) (n,) of a camera (its
-    row: rtcli/core/camera.py) into out (n, 3). The caller gives the scratch: stack (the
-    traversal's) and frames (pack.frames), so that this entry allocates nothing
-    and runs as machine code without numba (rtcli/kernels/machinecode)."""
-    for i in range(len(x)):
-        out[i] = radiance(g, s, primary_ray(cam, x[i], y[i], nc, nr), counts, frames, stack)
+    row: rtcli/core/camera.py) into out (n, 3), their first hits found W at a time as a packet
+    (compiled/packets.py). The caller gives the scratch: stack (the traversal's), frames
+    (pack.frames) and lanes (packets.ROWS, W), so that this entry allocates nothing and runs as
+    machine code without numba (rtcli/kernels/machinecode)."""
+    for i0 in range(0, len(x), W):
+        n = min(W, len(x) - i0)
+        for l in range(n):
+            ox, oy, oz, dx, dy, dz = primary_ray(cam, x[i0 + l], y[i0 + l], nc, nr)
+            lanes[OX, l], lanes[OY, l], lanes[OZ, l], lanes[DX, l], lanes[DY, l], lanes[DZ, l] = ox, oy, oz, dx, dy, dz
+            lanes[T_MIN, l], lanes[T_MAX, l] = 0.0, np.inf
+        scene_hit_packet(g, lanes, n, NEAREST, stack)
+        for l in range(n):
+            ray = (lanes[OX, l], lanes[OY, l], lanes[OZ, l], lanes[DX, l], lanes[DY, l], lanes[DZ, l])
+            hit = (lanes[LISTED + BEST, l], to_int(lanes[LISTED + WON, l]), to_int(lanes[LISTED + PRIM, l]))
+            out[i0 + l] = radiance(g, s, ray, hit, counts, frames, stack)

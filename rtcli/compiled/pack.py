@@ -70,6 +70,15 @@ ROW, DEPTH, PATH = 1, 2, 4                         # columns of leaves (KIND and
  W_REFLECT, W_REFRACT, REFRACTED_DIR, PATH_WEIGHT, MEDIA_COUNT, MEDIA_IOR) = (0, 3, 6, 9, 12, 15, 16, 17, 18, 21, 24,
                                                                             27, 30, 31)
 
+# A packet's scratch (compiled/packets.py), `lanes` (ROWS, W): one column per ray. Its rows: two
+# blocks of rays (origin, direction, 1 / direction), the world rays and the rays in the space of the
+# mesh being walked; each lane's interval; answers (t, entry, prim) of the scene tree's walk, of a
+# mesh tree's walk and of the listed objects (in the end, of the whole scene).
+W = 8                                               # lanes: 8 float64, one AVX-512 register
+OX, OY, OZ, DX, DY, DZ, IX, IY, IZ = range(9)      # a block of rays
+WORLD_RAYS, OBJECT_RAYS, T_MIN, T_MAX, TREE, MESH, LISTED, ROWS = 0, 9, 18, 19, 20, 23, 26, 29
+BEST, WON, PRIM = range(3)                          # an answer's rows
+
 # Few arrays on purpose: numba passes each array argument as several machine words.
 Geometry = namedtuple("Geometry", "objects ints transforms listed nodes links perm pool program leaves")
 Looks = namedtuple("Looks", "ka kd ks shininess emission kr kt ior shiny mirror clear fresnel filters texture "
@@ -245,6 +254,11 @@ def looks(scene) -> Looks:
                  float(scene.settings.medium_ior), scene.settings.total_internal_reflection == "reflect",
                  bool(table.filters.any()), scene.settings.shadow_terminator == "offset",
                  float(scene.settings.adc_bailout))
+
+
+def lanes() -> np.ndarray:
+    """A packet's scratch (ROWS, W), above."""
+    return np.empty((ROWS, W))
 
 
 def frames(max_depth: int) -> np.ndarray:

@@ -178,11 +178,15 @@ def object_leaf(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, botto
 WALK_OBJECTS = compiled(walk, LEAF=object_leaf)
 
 
-@per_ray(inline=True)
-def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
-    """(t, object, prim): the nearest hit in (t_min, t_max); with `shadow` (a mode of
-    core/bvh.py) among the objects that cast shadows, any (ANY_CASTER) or the nearest; object -1
-    on a miss. stack: scratch for both tree levels."""
+@per_ray
+def object_leaf_one(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom):
+    """object_leaf as a call of its own, for a packet's lanes one by one (compiled/packets.py)."""
+    return object_leaf(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)
+
+
+@per_ray
+def listed_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
+    """(t, object, prim): the nearest hit in (t_min, t_max) among the listed objects (as scene_hit)."""
     best, obj, prim = t_max, -1, 0
     for j in range(len(g.listed)):
         k = g.listed[j]
@@ -193,12 +197,32 @@ def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
             best, obj, prim = t, k, p
             if shadow == ANY_CASTER:
                 return best, obj, prim
+    return best, obj, prim
+
+
+@per_ray(inline=True)
+def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
+    """(t, object, prim): the nearest hit in (t_min, t_max); with `shadow` (a mode of
+    core/bvh.py) among the objects that cast shadows, any (ANY_CASTER) or the nearest; object -1
+    on a miss. stack: scratch for both tree levels."""
+    best, obj, prim = listed_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack)
+    if shadow == ANY_CASTER and obj >= 0:
+        return best, obj, prim
     if g.links[0, CHILD] < 0 and g.links[0, COUNT] == 0:          # no tree (a scene of few objects)
         return best, obj, prim
     t, k, p = WALK_OBJECTS(g, 0, ox, oy, oz, dx, dy, dz, t_min, best, shadow, stack, 0)
     if k >= 0:
         return t, k, p
     return best, obj, prim
+
+
+@per_ray(entry=True)
+def scene_rays(g, o, d, t_min, t_max, shadow, t, hit, prim, stack):
+    """scene_hit for each ray of o, d (3, n) with its t_min, t_max (n,): into t, hit (the object,
+    -1 on a miss) and prim (n,); for tests, beside packets.packet_rays."""
+    for i in range(o.shape[1]):
+        t[i], hit[i], prim[i] = scene_hit(g, o[0, i], o[1, i], o[2, i], d[0, i], d[1, i], d[2, i], t_min[i],
+                                          t_max[i], shadow, stack)
 
 
 # --- for the numpy engine: the same walks over arrays of rays ---
