@@ -101,7 +101,7 @@ ENTRY = "trace_camera"
 def compiled_integrator():
     # start-up: the integrator's module compiles its dispatch with numba when imported, which a
     # render from the machine code files never loads
-    from rtcli.compiled.integrator import trace_camera
+    from rtcli.compiled.tracing import trace_camera
     return variants.compiled(trace_camera)
 
 

@@ -21,42 +21,32 @@ from __future__ import annotations
 import numpy as np
 
 from rtcli.compiled.pack import (
-    BEST,
+    BASE,
+    BLOCKED,
     COLOR_SUM,
     CSG_KIND,
-    DX,
-    DY,
-    DZ,
     ENTERING,
+    FEELERS,
     KIND,
-    LISTED,
     MATERIAL_OF,
     MEDIA_COUNT,
     MEDIA_IOR,
     NG,
-    OX,
-    OY,
-    OZ,
+    PACKED_LIGHTS,
     PATH_WEIGHT,
-    PRIM,
     REFRACTED_DIR,
     SMOOTH_KINDS,
     STAGE,
-    T_MAX,
-    T_MIN,
+    TEXTURE,
     W_REFLECT,
     W_REFRACT,
-    WON,
     XFORM,
     D,
     N,
     P,
-    W,
 )
-from rtcli.compiled.packets import scene_hit_packet
 from rtcli.compiled.query import NORMALS_ANY, UV_ANY, csg_normals, csg_uv, leaf_point, material_of, scene_hit
 from rtcli.core.bvh import ANY_CASTER, NEAREST, NEAREST_CASTER
-from rtcli.core.camera import primary_ray
 from rtcli.core.dielectric import FEELER_CROSSINGS, fresnel, indices, refracted_media, split
 from rtcli.core.lights import COLOR, sample_point, toward, weight
 from rtcli.core.shading import ambient, diffuse, facing, path_weight, specular, specular_cos
@@ -144,25 +134,47 @@ def transmittance(g, s, sx, sy, sz, dx, dy, dz, stack):
 
 
 @per_ray(inline=True)
-def local(g, s, m, Tr, Tg, Tb, px, py, pz, bx, by, bz, nx, ny, nz, gx, gy, gz, Vx, Vy, Vz, counts, stack):
-    """The local term for one hit: emission and ambient, then each light point that sees it:
-    N.L > 0 and a shadow feeler from b (feeler_base) stepped off the surface reaching it."""
+def feeler(s, f, light, cell):
+    """A hit's (frame f) shadow feeler toward sample `cell` of a light: the light point q, the unit
+    L toward it and its distance r, N.L, and where the feeler leaves from: the feeler base stepped
+    s.offset off the surface along ng, on the lit side."""
+    px, py, pz = f[P], f[P + 1], f[P + 2]
+    qx, qy, qz = sample_point(light, cell, px, py, pz)
+    Lx, Ly, Lz, r = toward(qx, qy, qz, px, py, pz)
+    NL = dot(f[N], f[N + 1], f[N + 2], Lx, Ly, Lz)
+    sx, sy, sz = f[BASE] + s.offset * f[NG], f[BASE + 1] + s.offset * f[NG + 1], f[BASE + 2] + s.offset * f[NG + 2]
+    return qx, qy, qz, Lx, Ly, Lz, r, NL, sx, sy, sz
+
+
+@per_ray(inline=True)
+def through(g, s, f, li, qx, qy, qz, sx, sy, sz, stack):
+    """(r, g, b): how much of light li's point q reaches the hit: what a packet found (its feeler
+    blocked or not, compiled/tracing.py), else `transmittance` along the feeler from s."""
+    if li < PACKED_LIGHTS and (to_int(f[FEELERS]) >> li) & 1:
+        lit = 0.0 if (to_int(f[BLOCKED]) >> li) & 1 else 1.0
+        return lit, lit, lit
+    return transmittance(g, s, sx, sy, sz, qx - sx, qy - sy, qz - sz, stack)
+
+
+@per_ray(inline=True)
+def local(g, s, f, m, counts, stack):
+    """The local term for the hit of frame f: emission and ambient, then each light point that sees
+    it: N.L > 0 and a shadow feeler from the feeler base stepped off the surface reaching it."""
+    Tr, Tg, Tb = f[TEXTURE], f[TEXTURE + 1], f[TEXTURE + 2]
+    nx, ny, nz, Vx, Vy, Vz = f[N], f[N + 1], f[N + 2], -f[D], -f[D + 1], -f[D + 2]
     cr, cg, cb = ambient(s, m, s.ambient, Tr, Tg, Tb)
     NV = dot(nx, ny, nz, Vx, Vy, Vz)
-    sx, sy, sz = bx + s.offset * gx, by + s.offset * gy, bz + s.offset * gz    # the lit side
     for li in range(len(s.lights)):
         light, samples = s.lights[li], s.samples[li]
         for cell in range(samples):
-            qx, qy, qz = sample_point(light, cell, px, py, pz)
-            Lx, Ly, Lz, r = toward(qx, qy, qz, px, py, pz)
-            NL = dot(nx, ny, nz, Lx, Ly, Lz)
+            qx, qy, qz, Lx, Ly, Lz, r, NL, sx, sy, sz = feeler(s, f, light, cell)
             if not NL > 0:                                              # no contribution (004, case 2)
                 continue
             counts[SHADOW] += 1
-            through = transmittance(g, s, sx, sy, sz, qx - sx, qy - sy, qz - sz, stack)
-            if not (through[0] > 0 or through[1] > 0 or through[2] > 0):
+            T = through(g, s, f, li, qx, qy, qz, sx, sy, sz, stack)
+            if not (T[0] > 0 or T[1] > 0 or T[2] > 0):
                 continue
-            I = (light[COLOR] * through[0], light[COLOR + 1] * through[1], light[COLOR + 2] * through[2])
+            I = (light[COLOR] * T[0], light[COLOR + 1] * T[1], light[COLOR + 2] * T[2])
             w = weight(light, r, Lx, Ly, Lz, samples)
             dr, dg, db = diffuse(s, m, I, w, NL, Tr, Tg, Tb)
             cr, cg, cb = cr + dr, cg + dg, cb + db
@@ -174,31 +186,39 @@ def local(g, s, m, Tr, Tg, Tb, px, py, pz, bx, by, bz, nx, ny, nz, gx, gy, gz, V
 
 
 @per_ray(inline=True)
-def shade_local(g, s, ray, hit, f, counts, stack):
-    """The local term of one ray at its first hit (t, object, prim): (hit?, color); on a hit, f is
-    its frame (whose media the caller has set), with the weights of the secondary rays."""
+def prepare(g, s, ray, hit, f):
+    """The hit (t, object, prim) of a ray into its frame f: the point, the facing normals, the unit
+    direction, the material, the texture's color and the feeler base; no feeler traced yet. Whether
+    the ray hit at all."""
     ox, oy, oz, dx, dy, dz = ray
     t, k, prim = hit
     if k < 0:
-        return False, s.background[0], s.background[1], s.background[2]
+        return False
     px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
     nx, ny, nz, gx, gy, gz, qx, qy, qz = surface(g, k, prim, t, ox, oy, oz, dx, dy, dz)
     nx, ny, nz, gx, gy, gz, entering = facing(dx, dy, dz, nx, ny, nz, gx, gy, gz)
     m = material_of(g, k, prim)
     Dx, Dy, Dz = unit(dx, dy, dz)
-    Tr, Tg, Tb = texture_at(g, s, m, k, prim, qx, qy, qz)
-    bx, by, bz = feeler_base(g, s, k, prim, px, py, pz, qx, qy, qz)
-    cr, cg, cb = local(g, s, m, Tr, Tg, Tb, px, py, pz, bx, by, bz, nx, ny, nz, gx, gy, gz, -Dx, -Dy, -Dz, counts,
-                       stack)
-    f[COLOR_SUM], f[COLOR_SUM + 1], f[COLOR_SUM + 2] = cr, cg, cb
+    f[TEXTURE], f[TEXTURE + 1], f[TEXTURE + 2] = texture_at(g, s, m, k, prim, qx, qy, qz)
+    f[BASE], f[BASE + 1], f[BASE + 2] = feeler_base(g, s, k, prim, px, py, pz, qx, qy, qz)
     f[P], f[P + 1], f[P + 2], f[N], f[N + 1], f[N + 2] = px, py, pz, nx, ny, nz
     f[NG], f[NG + 1], f[NG + 2], f[D], f[D + 1], f[D + 2] = gx, gy, gz, Dx, Dy, Dz
-    f[ENTERING], f[MATERIAL_OF], f[STAGE] = 1.0 if entering else 0.0, m, 0
+    f[ENTERING], f[MATERIAL_OF], f[FEELERS], f[BLOCKED] = 1.0 if entering else 0.0, m, 0.0, 0.0
+    return True
+
+
+@per_ray(inline=True)
+def finish(g, s, f, counts, stack):
+    """The local color of the prepared hit of frame f, and the weights of its secondary rays."""
+    m = to_int(f[MATERIAL_OF])
+    cr, cg, cb = local(g, s, f, m, counts, stack)
+    f[COLOR_SUM], f[COLOR_SUM + 1], f[COLOR_SUM + 2], f[STAGE] = cr, cg, cb, 0
     f[W_REFLECT], f[W_REFLECT + 1], f[W_REFLECT + 2] = s.kr[m, 0], s.kr[m, 1], s.kr[m, 2]
     f[W_REFRACT], f[W_REFRACT + 1], f[W_REFRACT + 2] = 0.0, 0.0, 0.0
     if s.clear[m] or s.fresnel[m]:
+        Dx, Dy, Dz, nx, ny, nz = f[D], f[D + 1], f[D + 2], f[N], f[N + 1], f[N + 2]
         n1, n2 = indices(f[MEDIA_IOR:MEDIA_IOR + s.max_depth], int(f[MEDIA_COUNT]), s.medium_ior, s.ior[m],
-                         entering)
+                         f[ENTERING] != 0)
         eta = n1 / n2
         tx, ty, tz, tir = refract(Dx, Dy, Dz, nx, ny, nz, eta)
         R = fresnel(-dot(Dx, Dy, Dz, nx, ny, nz), eta) if s.fresnel[m] else 0.0      # split needs it only then
@@ -206,7 +226,7 @@ def shade_local(g, s, ray, hit, f, counts, stack):
         f[W_REFLECT], f[W_REFLECT + 1], f[W_REFLECT + 2] = wr
         f[W_REFRACT], f[W_REFRACT + 1], f[W_REFRACT + 2] = wt
         f[REFRACTED_DIR], f[REFRACTED_DIR + 1], f[REFRACTED_DIR + 2] = tx, ty, tz
-    return True, cr, cg, cb
+    return cr, cg, cb
 
 
 @per_ray(inline=True)
@@ -248,18 +268,22 @@ def next_ray(s, f, child, counts):
     return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
-@per_ray
-def radiance(g, s, ray, hit, counts, frames, stack):
-    """The color seen along one primary ray, whose first hit is found (a packet's): local + kr
-    radiance(mirror) + kt radiance(refracted), depth first with frames[L] the pending hit at depth
-    L + 1 instead of recursion."""
-    L = 0
+@per_ray(inline=True)
+def radiance(g, s, found, counts, frames, stack):
+    """The color seen along one primary ray, whose hit frames[0] holds, prepared (its feelers
+    traced by a packet or not: compiled/tracing.py): local + kr radiance(mirror) + kt
+    radiance(refracted), depth first with frames[L] the pending hit at depth L + 1 instead of
+    recursion."""
+    L, ray = 0, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)                       # the secondary ray, once there is one
     frames[0, MEDIA_COUNT] = 0                                        # the camera is in the scene's medium
     frames[0, PATH_WEIGHT:PATH_WEIGHT + 3] = 1.0                      # and the primary's path weight is 1
     while True:
         if L > 0:
             hit = scene_hit(g, ray[0], ray[1], ray[2], ray[3], ray[4], ray[5], 0.0, np.inf, NEAREST, stack)
-        found, cr, cg, cb = shade_local(g, s, ray, hit, frames[L], counts, stack)
+            found = prepare(g, s, ray, hit, frames[L])
+        cr, cg, cb = s.background[0], s.background[1], s.background[2]
+        if found:
+            cr, cg, cb = finish(g, s, frames[L], counts, stack)
         more = False
         if found and L + 1 < s.max_depth:
             more, ray = next_ray(s, frames[L], frames[L + 1], counts)
@@ -274,23 +298,3 @@ def radiance(g, s, ray, hit, counts, frames, stack):
         if not more:
             return cr, cg, cb
         L += 1
-
-
-@per_ray(entry=True)
-def trace_camera(g, s, cam, x, y, nc, nr, counts, stack, out, frames, lanes):
-    """The colors of the primary rays through the pixel coordinates (x, y) (n,) of a camera (its
-    row: rtcli/core/camera.py) into out (n, 3), their first hits found W at a time as a packet
-    (compiled/packets.py). The caller gives the scratch: stack (the traversal's), frames
-    (pack.frames) and lanes (packets.ROWS, W), so that this entry allocates nothing and runs as
-    machine code without numba (rtcli/kernels/machinecode)."""
-    for i0 in range(0, len(x), W):
-        n = min(W, len(x) - i0)
-        for l in range(n):
-            ox, oy, oz, dx, dy, dz = primary_ray(cam, x[i0 + l], y[i0 + l], nc, nr)
-            lanes[OX, l], lanes[OY, l], lanes[OZ, l], lanes[DX, l], lanes[DY, l], lanes[DZ, l] = ox, oy, oz, dx, dy, dz
-            lanes[T_MIN, l], lanes[T_MAX, l] = 0.0, np.inf
-        scene_hit_packet(g, lanes, n, NEAREST, stack)
-        for l in range(n):
-            ray = (lanes[OX, l], lanes[OY, l], lanes[OZ, l], lanes[DX, l], lanes[DY, l], lanes[DZ, l])
-            hit = (lanes[LISTED + BEST, l], to_int(lanes[LISTED + WON, l]), to_int(lanes[LISTED + PRIM, l]))
-            out[i0 + l] = radiance(g, s, ray, hit, counts, frames, stack)

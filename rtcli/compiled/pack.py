@@ -60,15 +60,18 @@ PROGRAM, LENGTH, LEAF_COUNT, SPANS, CHILDREN, SCRATCH, BOUNDED, LO, HI = 0, 1, 2
 LEAF = len(OPS)                                    # the program's code for a leaf (the ops are csg's)
 ROW, DEPTH, PATH = 1, 2, 4                         # columns of leaves (KIND and MATERIAL as in ints)
 
-# The integrator's frames (compiled/integrator.py), one per depth. A frame: the local color so
-# far, the hit point p, the facing shading normal n and geometric normal ng, the unit direction
-# D of the ray that hit, entering (1 or 0), the material, which secondary ray comes next (STAGE:
-# 0 the mirror ray, 1 the refracted ray, 2 done), the weights of the mirror and refracted rays,
-# the refracted direction, the path weight of the ray that hit (adc_bailout's, wavefront/trace.py),
-# and the media the ray is in: how many, then their iors (max_depth slots from MEDIA_IOR on).
-(COLOR_SUM, P, N, NG, D, ENTERING, MATERIAL_OF, STAGE,
- W_REFLECT, W_REFRACT, REFRACTED_DIR, PATH_WEIGHT, MEDIA_COUNT, MEDIA_IOR) = (0, 3, 6, 9, 12, 15, 16, 17, 18, 21, 24,
-                                                                            27, 30, 31)
+# The integrator's frames (compiled/integrator.py), one per depth, then one per lane of a packet
+# (the primary hits). A frame: the local color so far, the hit point p, the facing shading normal n
+# and geometric normal ng, the unit direction D of the ray that hit, entering (1 or 0), the
+# material, which secondary ray comes next (STAGE: 0 the mirror ray, 1 the refracted ray, 2 done),
+# the weights of the mirror and refracted rays, the refracted direction, the path weight of the ray
+# that hit (adc_bailout's, wavefront/trace.py), the texture's color T at the hit, where its shadow
+# feelers leave from (less the offset), the lights whose feeler a packet has traced (FEELERS, a
+# bit a light) and those it found blocked (BLOCKED), and the media the ray is in: how many, then
+# their iors (max_depth slots from MEDIA_IOR on).
+(COLOR_SUM, P, N, NG, D, ENTERING, MATERIAL_OF, STAGE, W_REFLECT, W_REFRACT, REFRACTED_DIR, PATH_WEIGHT, TEXTURE,
+ BASE, FEELERS, BLOCKED, MEDIA_COUNT, MEDIA_IOR) = (0, 3, 6, 9, 12, 15, 16, 17, 18, 21, 24, 27, 30, 33, 36, 37, 38, 39)
+PACKED_LIGHTS = 50                                  # lights whose feelers packets trace (bits of a float)
 
 # A packet's scratch (compiled/packets.py), `lanes` (ROWS, W): one column per ray. Its rows: two
 # blocks of rays (origin, direction, 1 / direction), the world rays and the rays in the space of the
@@ -262,6 +265,6 @@ def lanes() -> np.ndarray:
 
 
 def frames(max_depth: int) -> np.ndarray:
-    """The integrator's scratch: a frame per depth (at least one), each its columns above and then
-    max_depth media slots."""
-    return np.empty((max(max_depth, 1), MEDIA_IOR + max_depth))
+    """The integrator's scratch: a frame per depth (at least one) and one per lane, each its columns
+    above and then max_depth media slots."""
+    return np.empty((max(max_depth, 1) + W, MEDIA_IOR + max_depth))

@@ -120,7 +120,8 @@ def packet_walk(g, root, pk, alive, shadow, stack, bottom):
             met0, met1, swap = children(g, child, pk, lanes, RAYS, OUT)
             both = met0 & met1
             order = 1 if (swap & both & -both) != 0 else 0                # the lowest lane's order
-            gone = both & (swap ^ (ALL if order else 0))                  # lanes that would go the other way
+            gone = both & (swap ^ (ALL if order else 0))                  # lanes that would go the other way,
+            gone = 0 if shadow == ANY_CASTER else gone                    # which matters only for the nearest
             left, alive, met0, met1 = left | gone, alive & ~gone, met0 & ~gone, met1 & ~gone
             first, second, met_first, met_second = child, child + 1, met0, met1
             if order:
@@ -231,12 +232,14 @@ WALK_SCENE = compiled(packet_walk, LEAF_PACKET=object_packet, RAYS=WORLD_RAYS, O
 
 
 @per_ray
-def scene_hit_packet(g, pk, n, shadow, stack):
-    """`scene_hit` (compiled/query.py) for the first n lanes of the packet (their rays and
+def scene_hit_packet(g, pk, wanted, shadow, stack):
+    """`scene_hit` (compiled/query.py) for the packet's lanes in `wanted` (their rays and
     intervals set): each lane's (t, object, prim) into its LISTED rows. The listed objects lane by
     lane, then the scene's tree as a packet, then the lanes that left it alone."""
     alive = 0
-    for l in range(n):
+    for l in range(W):
+        if not lane(wanted, l):
+            continue
         pk[IX, l], pk[IY, l], pk[IZ, l] = reciprocal(pk[DX, l]), reciprocal(pk[DY, l]), reciprocal(pk[DZ, l])
         t, k, p = listed_hit(g, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l], pk[T_MIN, l],
                              pk[T_MAX, l], shadow, stack)
@@ -247,13 +250,15 @@ def scene_hit_packet(g, pk, n, shadow, stack):
     if alive == 0 or (g.links[0, CHILD] < 0 and g.links[0, COUNT] == 0):     # no tree (a scene of few objects)
         return
     left = WALK_SCENE(g, 0, pk, alive, shadow, stack, 0)
-    for l in range(n):
+    for l in range(W):
+        if not lane(alive, l):
+            continue
         if lane(left, l):
             t, k, p = WALK_OBJECTS(g, 0, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l],
                                    pk[T_MIN, l], pk[LISTED + BEST, l], shadow, stack, 0)
         else:
             t, k, p = pk[TREE + BEST, l], to_int(pk[TREE + WON, l]), to_int(pk[TREE + PRIM, l])
-        if lane(alive, l) and k >= 0:
+        if k >= 0:
             pk[LISTED + BEST, l], pk[LISTED + WON, l], pk[LISTED + PRIM, l] = t, k, p
 
 
@@ -267,7 +272,7 @@ def packet_rays(g, o, d, t_min, t_max, shadow, t, hit, prim, stack, pk):
             for r in range(3):
                 pk[OX + r, l], pk[DX + r, l] = o[r, i0 + l], d[r, i0 + l]
             pk[T_MIN, l], pk[T_MAX, l] = t_min[i0 + l], t_max[i0 + l]
-        scene_hit_packet(g, pk, n, shadow, stack)
+        scene_hit_packet(g, pk, (1 << n) - 1, shadow, stack)
         for l in range(n):
             t[i0 + l], hit[i0 + l] = pk[LISTED + BEST, l], to_int(pk[LISTED + WON, l])
             prim[i0 + l] = to_int(pk[LISTED + PRIM, l])

@@ -184,7 +184,7 @@ def object_leaf_one(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, b
     return object_leaf(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, bottom)
 
 
-@per_ray
+@per_ray(inline=True)
 def listed_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
     """(t, object, prim): the nearest hit in (t_min, t_max) among the listed objects (as scene_hit)."""
     best, obj, prim = t_max, -1, 0

@@ -4,6 +4,9 @@ for coherent rays (a camera's, where lanes stay together) and scattered ones (wh
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -98,3 +101,38 @@ def test_the_ties_scene_has_ties(tmp_path):
     scene = ties_scene(tmp_path)
     _, hit, _ = answers(compiled_entries()[1], scene, *camera_rays(scene), NEAREST, np.inf, False)
     assert ((hit >= 0) & (hit < 24)).sum() > 100 and (hit == 24).sum() > 100
+
+
+VECTOR_CHECK = """
+import re, sys
+import numpy as np
+from rtcli.compiled import packets
+from rtcli.compiled.pack import geometry, lanes
+from rtcli.kernels.variants import compiled
+from rtcli.scenefile.load import load_scene
+entry = compiled(packets.packet_rays)
+g, words = geometry(load_scene(sys.argv[1]), tree=True)
+n = 8
+entry(g, np.zeros((3, n)), np.ones((3, n)), np.zeros(n), np.full(n, np.inf), 0, np.empty(n),
+      np.empty(n, np.int64), np.empty(n, np.int64), np.empty(2 * words, np.int64), lanes())
+for part in re.split(r"\\n(?=[^\\s.#][^\\n]*:\\n)", entry.inspect_asm(entry.signatures[0])):
+    if "packet_walk" in part.split(":")[0]:
+        print(" ".join(sorted(set(re.findall(r"^\\s+(v?(?:mul|sub|cmp\\w*|min|max)pd)\\s", part, re.M)))))
+"""
+
+
+@pytest.mark.slow
+def test_the_walks_test_boxes_and_triangles_in_vector_instructions(tmp_path):
+    """The machine code of both packet walks (the scene's tree, a mesh's) holds packed-double
+    multiplies, subtractions, compares, minima and maxima: the lane loops of the slab test and of
+    the triangle test became vector instructions. Compiled afresh (numba shows no machine code it
+    loads from its cache)."""
+    env = dict(os.environ, RTCLI_CACHE_DIR=str(tmp_path))
+    run = subprocess.run([sys.executable, "-c", VECTOR_CHECK, str(ROOT / "bench/torus100k.yaml")], env=env,
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    walks = [set(line.split()) for line in run.stdout.splitlines()]
+    assert len(walks) == 2, run.stdout
+    for ops in walks:
+        names = {op.lstrip("v") for op in ops}
+        assert {"mulpd", "subpd", "minpd", "maxpd"} <= names and any(op.startswith("cmp") for op in names), ops
