@@ -6,7 +6,7 @@ compiles one entry point, as a render or `rtcli warmup` would, and reports the s
 that compile: wall clock and CPU (user + sys of the process while it compiled, less
 sensitive to other processes on a shared machine). The entry points:
 
-    engine     the compiled engine's integrator (compiled/integrator.py's trace_camera)
+    engine     the compiled engine's entry (compiled/tracing.py's trace_camera)
     walks      the numpy engine's BVH walks, over a mesh's triangles and over a tree of spheres
     build      the BVH build (core/bvh_build.py's levels)
     warmup     the whole `rtcli warmup` command as a process (machine code files written too)

@@ -64,8 +64,12 @@ def measured(cmd: list[str], cwd: str) -> tuple[float, str, float]:
         err.seek(0)
         stdout, stderr = out.read().decode(), err.read().decode()
     if p.returncode != 0:
-        sys.exit(f"failed ({p.returncode}): {' '.join(cmd)}\n{stderr[-2000:]}")
+        raise Failed(f"failed ({p.returncode}): {' '.join(cmd)}\n{stderr[-2000:]}")
     return seconds, stdout, usage.ru_maxrss / 1024
+
+
+class Failed(RuntimeError):
+    """A program of the bench exited with an error: rtcli's ends the bench, a peer's its column."""
 
 
 def rtcli_cmd(scene, out, w, h, workers, engine):
@@ -148,8 +152,17 @@ def bench(scene, w, h, runs, workers, engine, tmp, pov, mitsuba):
                 seconds, stdout, peak = measured(rtcli_cmd(rt_scene, out("rt"), w, h, workers, engine), folder)
                 rays = int(re.search(r"(\d+) total", stdout).group(1))
                 used = re.search(r"(\w+) engine", stdout).group(1)
+            elif name in times:
+                try:
+                    seconds, _, peak = measured(cmd, folder)
+                except Failed as e:                  # say why once; the column shows "failed"
+                    lines = str(e).strip().splitlines()
+                    why = next((line for line in lines if "ERROR" in line or "Error" in line), lines[-1])
+                    print(f"{name} on {scene} {w}x{h}: {why.strip()[:200]}", file=sys.stderr)
+                    del times[name], peaks[name]
+                    continue
             else:
-                seconds, _, peak = measured(cmd, folder)
+                continue
             times[name].append(seconds)
             peaks[name].append(peak)
     if rt_scene != scene:
@@ -159,6 +172,15 @@ def bench(scene, w, h, runs, workers, engine, tmp, pov, mitsuba):
     share = differing_share(out("rt"), out("pov")) if pov else float("nan")
     phase = {k: statistics.median(p[k] for p in phases) for k in phases[0]} if phases else {}
     return medians, rays / medians["rtcli"], share, used, memory, phase
+
+
+def failed(scene: str) -> set:
+    """The peers that could render `scene` (mitsuba_scenes' scenes) but failed: not in the medians."""
+    from mitsuba_scenes import SCENES as MITSUBA_SCENES
+    return {"POV-Ray"} | (set(MITSUBA_VARIANTS) if scene in MITSUBA_SCENES else set())
+
+
+MITSUBA_VARIANTS: list = []
 
 
 def main():
@@ -180,6 +202,7 @@ def main():
     mitsuba = None
     if has_mitsuba(args.mitsuba_python):
         mitsuba = {"python": args.mitsuba_python, "variants": args.mitsuba_variants.split(",")}
+        MITSUBA_VARIANTS[:] = mitsuba["variants"]
     else:
         print("mitsuba not found (pip install -e '.[bench]', or --mitsuba-python): no Mitsuba columns")
     tmp = args.keep or tempfile.mkdtemp(prefix="rtcli-bench-")
@@ -193,8 +216,8 @@ def main():
             medians, rate, share, used, memory, phase = bench(scene, w, h, args.runs, args.workers, args.engine,
                                                               tmp, pov, mitsuba)
             rt = medians["rtcli"]
-            cells = "".join(f"{medians[p]:15.2f} {rt / medians[p]:6.2f} " if p in medians else f"{'-':>15} {'-':>6} "
-                            for p in peers)
+            cells = "".join(f"{medians[p]:15.2f} {rt / medians[p]:6.2f} " if p in medians else
+                            f"{'failed' if p in failed(scene) else '-':>15} {'-':>6} " for p in peers)
             print(f"{scene:<10} {size:>9} {used:>8} {rt:8.2f} {cells}{rate:13,.0f} {share:7.1%}", flush=True)
             if scene in BIG:
                 print(f"{'':<10} rtcli phases (median s): " + ", ".join(f"{k} {v:.2f}" for k, v in phase.items())

@@ -87,7 +87,7 @@ objects:
 """                                      # about 50 s on two cores with --engine numpy
 
 # numba's cache index files of two entry points, by the names numba gives them
-TRACE_CAMERA = "integrator.trace_camera-*.nbi"
+TRACE_CAMERA = "tracing.trace_camera-*.nbi"
 WALKS = "bvh.walk_rays_*.nbi"
 
 

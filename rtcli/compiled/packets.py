@@ -1,5 +1,6 @@
 """Coherent packets: W rays walked through the scene's BVH together (the compiled engine's primary
-rays), each node's box and each leaf's triangles tested for all lanes at once.
+rays and their feelers toward point lights: compiled/tracing.py), each node's box and each leaf's
+triangles or sphere tested for all lanes at once.
 
 A packet is a block of rows of `lanes` (ROWS, W), one column per ray: its origin, direction and
 1 / direction, in world space and in the space of the mesh being walked, and each lane's answer so
@@ -13,6 +14,7 @@ node and the lanes that met its box when it was pushed; a lane tests a popped no
 where its own walk would. Where two children are both met by several lanes, the packet goes into
 the one nearer for its lowest such lane; a lane that would go the other way first leaves the
 packet and is walked alone from the start, as are the lanes that leave inside a mesh's tree.
+A feeler (ANY_CASTER) never leaves: whether any caster lies on it does not depend on the order.
 Lanes are bits of an int64 mask.
 """
 

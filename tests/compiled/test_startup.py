@@ -282,7 +282,7 @@ def test_after_warmup_no_scene_compiles_anything(warm, monkeypatch):
     """The warmup's calls have the argument types of every render: every scene's arguments fit
     the integrator's machine code file, and through numba there is one machine code each."""
     from rtcli.compiled import query
-    from rtcli.compiled.integrator import trace_camera
+    from rtcli.compiled.tracing import trace_camera
     from rtcli.rendering.tiles import Job, render
     from rtcli.scenefile.load import load_scene
     scenes = [load_scene(str(p)) for p in sorted((ROOT / "scenes").glob("*.yaml")) +

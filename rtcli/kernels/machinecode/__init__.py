@@ -4,7 +4,7 @@ numba's on-disk cache saves the minute of compiling, but a process that loads it
 imports numba and sets up its typing and lowering tables, about 0.4 s of every render:
 more than the whole trace of a 640x480 image, and up to a second more when the 180 MB
 LLVM library has to come back from disk. So when numba has compiled an entry point (the
-integrator, compiled/integrator.py's trace_camera; the BVH build, core/bvh_build.py's
+integrator's entry, compiled/tracing.py's trace_camera; the BVH build, core/bvh_build.py's
 levels), `make` also writes its machine code as a small shared library beside numba's
 cache (position-independent object code from numba's optimised module, linked by the C
 compiler, `cc`), and `load` opens it with ctypes: no numba, no LLVM, about a millisecond.
