@@ -1,21 +1,15 @@
 """Coherent packets: W rays walked through the scene's BVH together (the compiled engine's primary
 rays and their feelers toward point lights: compiled/tracing.py), each node's box and each leaf's
-triangles or sphere tested for all lanes at once.
+triangles or sphere tested for all lanes at once, in vector instructions: loops over the lanes of
+the branch-free kernels the one-ray walk calls. A packet is a block of rows of `lanes` (ROWS, W),
+a column a ray (compiled/pack.py). Lanes are bits of an int64 mask.
 
-A packet is a block of rows of `lanes` (ROWS, W), one column per ray: its origin, direction and
-1 / direction, in world space and in the space of the mesh being walked, and each lane's answer so
-far. The node test and the triangle test are loops over the W lanes of the same branch-free
-kernels the one-ray walk calls (core/bvh.py's `slab`, shapes/triangle.py's `triangle_t`), written
-so that LLVM turns each into vector instructions (docs/architecture.md, "Packets").
-
-Same answers as the one-ray walk, bit for bit, ties included: each lane visits the nodes its own
-walk (core/bvh.py `walk`) would, in the same order, against the same best t. A stack entry holds a
-node and the lanes that met its box when it was pushed; a lane tests a popped node again only
-where its own walk would. Where two children are both met by several lanes, the packet goes into
-the one nearer for its lowest such lane; a lane that would go the other way first leaves the
-packet and is walked alone from the start, as are the lanes that leave inside a mesh's tree.
-A feeler (ANY_CASTER) never leaves: whether any caster lies on it does not depend on the order.
-Lanes are bits of an int64 mask.
+The same answers as the one-ray walk (core/bvh.py `walk`), bit for bit, ties included: each lane
+visits the nodes its own walk would, in the same order, against the same best t. A stack entry
+holds a node and the lanes that met its box when it was pushed. Where several lanes meet both
+children, the packet goes first into the one nearer for its lowest such lane; a lane for which the
+other is nearer leaves the packet and is walked alone afterwards. A feeler (ANY_CASTER) never
+leaves: whether any caster lies on it does not depend on the order (docs/architecture.md, Packets).
 """
 
 from __future__ import annotations
@@ -46,7 +40,7 @@ from rtcli.compiled.pack import (
     XFORM,
     W,
 )
-from rtcli.compiled.query import WALK_OBJECTS, listed_hit, object_leaf_one
+from rtcli.compiled.query import WALK_OBJECTS, object_leaf, object_leaf_one, scene_hit
 from rtcli.core.bvh import ANY_CASTER, CHILD, COUNT, NEAREST, START, reciprocal, slab
 from rtcli.core.transform import ray_to_object
 from rtcli.kernels.variants import INF, compiled, per_ray, to_int
@@ -84,8 +78,7 @@ def meets(g, node, pk, lanes, rays, out):
 def children(g, child, pk, lanes, rays, out):
     """(the lanes meeting child's box, those meeting child + 1's, those for which child + 1's entry
     is the nearer one): the one-ray walk's test of a node's two children, for W rays at once."""
-    a, b = child, child + 1
-    met0, met1, swap = 0, 0, 0
+    a, b, met0, met1, swap = child, child + 1, 0, 0, 0
     for l in range(W):
         ox, oy, oz = pk[rays + OX, l], pk[rays + OY, l], pk[rays + OZ, l]
         ix, iy, iz = pk[rays + IX, l], pk[rays + IY, l], pk[rays + IZ, l]
@@ -170,15 +163,14 @@ def mesh_packet(g, k, pk, lanes, shadow, stack, bottom):
     """A mesh object's packet walk: the lanes' rays taken into its space (OBJECT_RAYS), its own tree
     walked with each lane's best so far, and each lane's answer taken where it is nearer. (The
     lanes done, those that left.)"""
-    x = g.ints[k, XFORM]
+    x, r = g.ints[k, XFORM], OBJECT_RAYS
     for l in range(W):
         ox, oy, oz, dx, dy, dz = pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l]
         if x >= 0:
             ox, oy, oz, dx, dy, dz = ray_to_object(g.transforms[x], 0, ox, oy, oz, dx, dy, dz)
-        pk[OBJECT_RAYS + OX, l], pk[OBJECT_RAYS + OY, l], pk[OBJECT_RAYS + OZ, l] = ox, oy, oz
-        pk[OBJECT_RAYS + DX, l], pk[OBJECT_RAYS + DY, l], pk[OBJECT_RAYS + DZ, l] = dx, dy, dz
-        pk[OBJECT_RAYS + IX, l], pk[OBJECT_RAYS + IY, l] = reciprocal(dx), reciprocal(dy)
-        pk[OBJECT_RAYS + IZ, l] = reciprocal(dz)
+        pk[r + OX, l], pk[r + OY, l], pk[r + OZ, l] = ox, oy, oz
+        pk[r + DX, l], pk[r + DY, l], pk[r + DZ, l] = dx, dy, dz
+        pk[r + IX, l], pk[r + IY, l], pk[r + IZ, l] = reciprocal(dx), reciprocal(dy), reciprocal(dz)
         pk[MESH + BEST, l], pk[MESH + WON, l] = pk[TREE + BEST, l], -1.0
     gone = WALK_MESH(g, to_int(g.objects[k, ROOT_AT]), pk, lanes, shadow, stack, bottom)
     first, hit = g.objects[k, FIRST_AT], 0
@@ -233,48 +225,76 @@ def object_packet(g, k, pk, lanes, shadow, stack, bottom):
 WALK_SCENE = compiled(packet_walk, LEAF_PACKET=object_packet, RAYS=WORLD_RAYS, OUT=TREE)
 
 
+@per_ray(inline=True)
+def listed_packet(g, k, pk, lanes, shadow, stack):
+    """A listed object k for the packet's lanes: a mesh or a sphere as the tree's leaves are, any
+    other shape (a plane, say) lane by lane, inline (a call per lane would cost more than its test)."""
+    if g.ints[k, KIND] == MESH_KIND or g.ints[k, KIND] == SPHERE_KIND:
+        return object_packet(g, k, pk, lanes, shadow, stack, 0)
+    hit = 0
+    for l in range(W):
+        if lane(lanes, l):
+            t, p = object_leaf(g, k, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l], pk[T_MIN, l],
+                               pk[TREE + BEST, l], shadow, stack, 0)
+            if t < pk[TREE + BEST, l]:
+                pk[TREE + BEST, l], pk[TREE + WON, l], pk[TREE + PRIM, l] = t, k, p
+                hit |= 1 << l
+    return (hit if shadow == ANY_CASTER else 0), 0
+
+
 @per_ray
 def scene_hit_packet(g, pk, wanted, shadow, stack):
     """`scene_hit` (compiled/query.py) for the packet's lanes in `wanted` (their rays and
-    intervals set): each lane's (t, object, prim) into its LISTED rows. The listed objects lane by
-    lane, then the scene's tree as a packet, then the lanes that left it alone."""
+    intervals set): each lane's (t, object, prim) into its LISTED rows. The listed objects as the
+    scene tree's leaves are (a mesh among them, say a scene's only object, walked as a packet),
+    then the scene's tree as a packet, then each lane that left alone; returns those lanes."""
     alive = 0
     for l in range(W):
-        if not lane(wanted, l):
-            continue
-        pk[IX, l], pk[IY, l], pk[IZ, l] = reciprocal(pk[DX, l]), reciprocal(pk[DY, l]), reciprocal(pk[DZ, l])
-        t, k, p = listed_hit(g, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l], pk[T_MIN, l],
-                             pk[T_MAX, l], shadow, stack)
-        pk[LISTED + BEST, l], pk[LISTED + WON, l], pk[LISTED + PRIM, l] = t, k, p
-        pk[TREE + BEST, l], pk[TREE + WON, l] = t, -1.0
-        if not (shadow == ANY_CASTER and k >= 0):
+        if lane(wanted, l):
+            pk[IX, l], pk[IY, l], pk[IZ, l] = reciprocal(pk[DX, l]), reciprocal(pk[DY, l]), reciprocal(pk[DZ, l])
+            pk[TREE + BEST, l], pk[TREE + WON, l], pk[TREE + PRIM, l] = pk[T_MAX, l], -1.0, 0.0
             alive |= 1 << l
-    if alive == 0 or (g.links[0, CHILD] < 0 and g.links[0, COUNT] == 0):     # no tree (a scene of few objects)
-        return
-    left = WALK_SCENE(g, 0, pk, alive, shadow, stack, 0)
+    gone_listed = 0
+    for j in range(len(g.listed)):
+        if alive == 0:
+            break
+        done, gone = listed_packet(g, g.listed[j], pk, alive, shadow, stack)
+        gone_listed, alive = gone_listed | gone, alive & ~(done | gone)
+    left = 0
+    for l in range(W):                                    # the listed objects' answers; the tree's next
+        pk[LISTED + BEST, l], pk[LISTED + WON, l], pk[LISTED + PRIM, l] = pk[TREE + BEST, l], pk[TREE + WON, l], \
+            pk[TREE + PRIM, l]
+        pk[TREE + WON, l] = -1.0
+    if alive != 0 and not (g.links[0, CHILD] < 0 and g.links[0, COUNT] == 0):    # a tree (not a scene of few objects)
+        left = WALK_SCENE(g, 0, pk, alive, shadow, stack, 0)
     for l in range(W):
-        if not lane(alive, l):
-            continue
-        if lane(left, l):
+        if lane(gone_listed, l):
+            t, k, p = scene_hit(g, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l], pk[T_MIN, l],
+                                pk[T_MAX, l], shadow, stack)
+        elif lane(left, l):
             t, k, p = WALK_OBJECTS(g, 0, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l],
                                    pk[T_MIN, l], pk[LISTED + BEST, l], shadow, stack, 0)
-        else:
+        elif lane(alive, l) and pk[TREE + WON, l] >= 0:
             t, k, p = pk[TREE + BEST, l], to_int(pk[TREE + WON, l]), to_int(pk[TREE + PRIM, l])
-        if k >= 0:
+        else:
+            continue
+        if k >= 0 or lane(gone_listed, l):
             pk[LISTED + BEST, l], pk[LISTED + WON, l], pk[LISTED + PRIM, l] = t, k, p
+    return left | gone_listed
 
 
 @per_ray(entry=True)
-def packet_rays(g, o, d, t_min, t_max, shadow, t, hit, prim, stack, pk):
+def packet_rays(g, o, d, t_min, t_max, shadow, t, hit, prim, stack, pk, left):
     """scene_hit_packet over the rays o, d (3, n), W at a time: into t, hit (the object, -1 on a
-    miss) and prim (n,); the packets' counterpart of query.scene_rays, for tests."""
+    miss) and prim (n,), and into left (n,) 1 for a ray that left its packet; the packets'
+    counterpart of query.scene_rays, for tests."""
     for i0 in range(0, o.shape[1], W):
         n = min(W, o.shape[1] - i0)
         for l in range(n):
             for r in range(3):
                 pk[OX + r, l], pk[DX + r, l] = o[r, i0 + l], d[r, i0 + l]
             pk[T_MIN, l], pk[T_MAX, l] = t_min[i0 + l], t_max[i0 + l]
-        scene_hit_packet(g, pk, (1 << n) - 1, shadow, stack)
+        gone = scene_hit_packet(g, pk, (1 << n) - 1, shadow, stack)
         for l in range(n):
-            t[i0 + l], hit[i0 + l] = pk[LISTED + BEST, l], to_int(pk[LISTED + WON, l])
+            t[i0 + l], hit[i0 + l], left[i0 + l] = pk[LISTED + BEST, l], to_int(pk[LISTED + WON, l]), (gone >> l) & 1
             prim[i0 + l] = to_int(pk[LISTED + PRIM, l])

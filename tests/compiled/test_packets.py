@@ -66,24 +66,27 @@ def scattered_rays(scene, n=3001):
     return o, rng.normal(size=(3, n))
 
 
-def answers(entry, scene, o, d, mode, t_max, packet: bool):
+def answers(entry, scene, o, d, mode, t_max, packet: bool, left=None):
+    """(t, object, prim) of each ray; with `packet`, `left` (n,) gets 1 for each ray that left its packet."""
     from rtcli.compiled.pack import geometry, lanes  # numba: only where it is installed
     g, words = geometry(scene, tree=scene.wants_bvh)
     n = o.shape[1]
     out = np.empty(n), np.empty(n, np.int64), np.empty(n, np.int64)
     args = (g, np.ascontiguousarray(o), np.ascontiguousarray(d), np.full(n, 1e-9), np.full(n, t_max), mode, *out,
             np.empty(2 * words, np.int64))
-    entry(*args, *((lanes(),) if packet else ()))
+    entry(*args, *((lanes(), np.zeros(n, np.int64) if left is None else left) if packet else ()))
     return out
 
 
 @pytest.mark.parametrize("name", SCENES + ["ties"])
 def test_packets_answer_as_one_ray_walks_do(name, tmp_path):
     scene = ties_scene(tmp_path) if name == "ties" else load_scene(str(ROOT / name))
-    packets, single, found = *compiled_entries(), []
+    packets, single, found, leavers = *compiled_entries(), [], {}
     for o, d in (camera_rays(scene), scattered_rays(scene)):
         for mode, t_max in ((NEAREST, np.inf), (NEAREST_CASTER, np.inf), (ANY_CASTER, 2.5)):
-            t, hit, prim = answers(packets, scene, o, d, mode, t_max, True)
+            left = np.zeros(o.shape[1], np.int64)
+            t, hit, prim = answers(packets, scene, o, d, mode, t_max, True, left)
+            leavers[mode] = leavers.get(mode, 0) + left.sum()
             t1, hit1, prim1 = answers(single, scene, o, d, mode, t_max, False)
             if mode == ANY_CASTER:                    # any caster will do: only whether one was found
                 assert np.array_equal(hit >= 0, hit1 >= 0), (name, mode)
@@ -93,6 +96,9 @@ def test_packets_answer_as_one_ray_walks_do(name, tmp_path):
             found += [hit1] if mode == NEAREST else []
     found = np.concatenate(found)
     assert (found >= 0).any() and (found < 0).any()            # the rays both hit and miss
+    assert leavers[ANY_CASTER] == 0                            # a feeler never leaves: any caster will do
+    if name in ("bench/torus100k.yaml", "bench/spheres1k.yaml"):
+        assert leavers[NEAREST] > 0                            # scattered rays disagree, and leave
 
 
 def test_the_ties_scene_has_ties(tmp_path):
