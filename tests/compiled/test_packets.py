@@ -120,7 +120,7 @@ entry = compiled(packets.packet_rays)
 g, words = geometry(load_scene(sys.argv[1]), tree=True)
 n = 8
 entry(g, np.zeros((3, n)), np.ones((3, n)), np.zeros(n), np.full(n, np.inf), 0, np.empty(n),
-      np.empty(n, np.int64), np.empty(n, np.int64), np.empty(2 * words, np.int64), lanes())
+      np.empty(n, np.int64), np.empty(n, np.int64), np.empty(2 * words, np.int64), lanes(), np.zeros(n, np.int64))
 for part in re.split(r"\\n(?=[^\\s.#][^\\n]*:\\n)", entry.inspect_asm(entry.signatures[0])):
     if "packet_walk" in part.split(":")[0]:
         print(" ".join(sorted(set(re.findall(r"^\\s+(v?(?:mul|sub|cmp\\w*|min|max)pd)\\s", part, re.M)))))
