@@ -148,7 +148,7 @@ def test_a_user_s_session_in_the_browser(tmp_path, browser, monkeypatch):
         page.click("[data-view=slider]")
         page.fill("#split", "30")
         page.dispatch_event("#split", "input")
-        assert page.is_visible("#golden")
+        page.wait_for_selector("#golden", state="visible")          # an image has a size once it has loaded
         assert page.evaluate("() => document.getElementById('golden').style.clipPath") == "inset(0px 0px 0px 30%)"
         page.click("[data-view=image]")
 
