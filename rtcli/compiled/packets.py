@@ -202,44 +202,38 @@ def sphere_packet(g, k, pk, lanes, shadow):
 
 
 @per_ray(inline=True)
+def alone(g, k, pk, lanes, shadow, stack, bottom):
+    """Object k for the packet's lanes one by one, by ONE (`object_leaf`: a call of its own for the
+    tree's leaves, inline for the listed objects, where a call per lane would cost more than a
+    plane's test). (The lanes done, none that left.)"""
+    hit = 0
+    for l in range(W):
+        if lane(lanes, l):
+            t, p = ONE(g, k, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l],  # noqa: F821
+                       pk[T_MIN, l], pk[TREE + BEST, l], shadow, stack, bottom)
+            if t < pk[TREE + BEST, l]:
+                pk[TREE + BEST, l], pk[TREE + WON, l], pk[TREE + PRIM, l] = t, k, p
+                hit |= 1 << l
+    return (hit if shadow == ANY_CASTER else 0), 0
+
+
+@per_ray(inline=True)
 def object_packet(g, k, pk, lanes, shadow, stack, bottom):
-    """The scene tree's leaf entry, object k, for the packet's lanes: a mesh walked as a packet, any
-    other shape lane by lane (`object_leaf`). (The lanes done, those that left.)"""
+    """Object k (a leaf entry of the scene's tree, or a listed object) for the packet's lanes: a
+    mesh walked as a packet, a sphere tested for all lanes at once, any other shape by ALONE. (The
+    lanes done, those that left.)"""
     if shadow != NEAREST and g.ints[k, CASTS] == 0:
         return 0, 0
     if g.ints[k, KIND] == MESH_KIND:
         return mesh_packet(g, k, pk, lanes, shadow, stack, bottom)
     if g.ints[k, KIND] == SPHERE_KIND:
         return sphere_packet(g, k, pk, lanes, shadow)
-    hit = 0
-    for l in range(W):
-        if lane(lanes, l):
-            t, p = object_leaf_one(g, k, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l],
-                                   pk[T_MIN, l], pk[TREE + BEST, l], shadow, stack, bottom)
-            if t < pk[TREE + BEST, l]:
-                pk[TREE + BEST, l], pk[TREE + WON, l], pk[TREE + PRIM, l] = t, k, p
-                hit |= 1 << l
-    return (hit if shadow == ANY_CASTER else 0), 0
+    return ALONE(g, k, pk, lanes, shadow, stack, bottom)  # noqa: F821
 
 
-WALK_SCENE = compiled(packet_walk, LEAF_PACKET=object_packet, RAYS=WORLD_RAYS, OUT=TREE)
-
-
-@per_ray(inline=True)
-def listed_packet(g, k, pk, lanes, shadow, stack):
-    """A listed object k for the packet's lanes: a mesh or a sphere as the tree's leaves are, any
-    other shape (a plane, say) lane by lane, inline (a call per lane would cost more than its test)."""
-    if g.ints[k, KIND] == MESH_KIND or g.ints[k, KIND] == SPHERE_KIND:
-        return object_packet(g, k, pk, lanes, shadow, stack, 0)
-    hit = 0
-    for l in range(W):
-        if lane(lanes, l):
-            t, p = object_leaf(g, k, pk[OX, l], pk[OY, l], pk[OZ, l], pk[DX, l], pk[DY, l], pk[DZ, l], pk[T_MIN, l],
-                               pk[TREE + BEST, l], shadow, stack, 0)
-            if t < pk[TREE + BEST, l]:
-                pk[TREE + BEST, l], pk[TREE + WON, l], pk[TREE + PRIM, l] = t, k, p
-                hit |= 1 << l
-    return (hit if shadow == ANY_CASTER else 0), 0
+TREE_LEAF = compiled(object_packet, ALONE=compiled(alone, ONE=object_leaf_one))
+LISTED_OBJECT = compiled(object_packet, ALONE=compiled(alone, ONE=object_leaf))
+WALK_SCENE = compiled(packet_walk, LEAF_PACKET=TREE_LEAF, RAYS=WORLD_RAYS, OUT=TREE)
 
 
 @per_ray
@@ -258,7 +252,7 @@ def scene_hit_packet(g, pk, wanted, shadow, stack):
     for j in range(len(g.listed)):
         if alive == 0:
             break
-        done, gone = listed_packet(g, g.listed[j], pk, alive, shadow, stack)
+        done, gone = LISTED_OBJECT(g, g.listed[j], pk, alive, shadow, stack, 0)
         gone_listed, alive = gone_listed | gone, alive & ~(done | gone)
     left = 0
     for l in range(W):                                    # the listed objects' answers; the tree's next

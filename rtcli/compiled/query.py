@@ -185,8 +185,10 @@ def object_leaf_one(g, k, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack, b
 
 
 @per_ray(inline=True)
-def listed_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
-    """(t, object, prim): the nearest hit in (t_min, t_max) among the listed objects (as scene_hit)."""
+def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
+    """(t, object, prim): the nearest hit in (t_min, t_max); with `shadow` (a mode of
+    core/bvh.py) among the objects that cast shadows, any (ANY_CASTER) or the nearest; object -1
+    on a miss. stack: scratch for both tree levels."""
     best, obj, prim = t_max, -1, 0
     for j in range(len(g.listed)):
         k = g.listed[j]
@@ -197,17 +199,6 @@ def listed_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
             best, obj, prim = t, k, p
             if shadow == ANY_CASTER:
                 return best, obj, prim
-    return best, obj, prim
-
-
-@per_ray(inline=True)
-def scene_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack):
-    """(t, object, prim): the nearest hit in (t_min, t_max); with `shadow` (a mode of
-    core/bvh.py) among the objects that cast shadows, any (ANY_CASTER) or the nearest; object -1
-    on a miss. stack: scratch for both tree levels."""
-    best, obj, prim = listed_hit(g, ox, oy, oz, dx, dy, dz, t_min, t_max, shadow, stack)
-    if shadow == ANY_CASTER and obj >= 0:
-        return best, obj, prim
     if g.links[0, CHILD] < 0 and g.links[0, COUNT] == 0:          # no tree (a scene of few objects)
         return best, obj, prim
     t, k, p = WALK_OBJECTS(g, 0, ox, oy, oz, dx, dy, dz, t_min, best, shadow, stack, 0)
